@@ -1,0 +1,39 @@
+# All dependencies come from Debian 12 packages (see scripts/setup.sh).
+find_package(Threads REQUIRED)
+find_package(Boost 1.74 REQUIRED)
+find_package(embree 3.13 REQUIRED)
+find_package(GTest REQUIRED)
+include(GoogleTest)
+find_package(benchmark QUIET)
+
+# OpenSubdiv: Debian's OpenSubdivConfig.cmake looks for static archives that are not shipped,
+# so the imported target is made by hand.
+find_path(OSD_INCLUDE_DIR opensubdiv/version.h REQUIRED)
+find_library(OSD_CPU_LIBRARY osdCPU REQUIRED)
+add_library(opensubdiv INTERFACE)
+target_include_directories(opensubdiv INTERFACE ${OSD_INCLUDE_DIR})
+target_link_libraries(opensubdiv INTERFACE ${OSD_CPU_LIBRARY})
+
+# OpenImageIO: its exported target names /usr/include/opencv4, which does not exist unless
+# OpenCV is installed, and CMake refuses to generate with a missing include directory.
+find_package(OpenImageIO 2.4 CONFIG REQUIRED)
+get_target_property(_oiio_includes OpenImageIO::OpenImageIO INTERFACE_INCLUDE_DIRECTORIES)
+list(FILTER _oiio_includes EXCLUDE REGEX "opencv")
+set_target_properties(OpenImageIO::OpenImageIO PROPERTIES
+  INTERFACE_INCLUDE_DIRECTORIES "${_oiio_includes}")
+
+# RapidJSON ships only include directories.
+find_package(RapidJSON REQUIRED)
+add_library(rapidjson INTERFACE)
+target_include_directories(rapidjson INTERFACE ${RAPIDJSON_INCLUDE_DIRS})
+
+# tinyobjloader: header plus library.
+find_path(TINYOBJ_INCLUDE_DIR tiny_obj_loader.h REQUIRED)
+find_library(TINYOBJ_LIBRARY tinyobjloader REQUIRED)
+add_library(tinyobjloader_lib INTERFACE)
+target_include_directories(tinyobjloader_lib INTERFACE ${TINYOBJ_INCLUDE_DIR})
+target_link_libraries(tinyobjloader_lib INTERFACE ${TINYOBJ_LIBRARY})
+
+# Headless OpenGL through EGL (GLVND).
+set(OpenGL_GL_PREFERENCE GLVND)
+find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)

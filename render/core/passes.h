@@ -1,0 +1,20 @@
+// What a renderer (raster or reference) is asked to produce, and how the approximation is shaded.
+#pragma once
+
+namespace limn::render {
+
+struct PassSelection {
+  bool color = false;
+  bool mask = false;
+  bool depth = false;
+  bool normal = false;
+  bool wireframe = false;  // colour with the mesh's edges drawn over it
+  int supersample = 0;     // > 0: also fill ImageSet::supersampledMask at this factor
+};
+
+enum class Shading {
+  Flat,   // one normal per triangle (the geometric one)
+  Smooth  // interpolated per-vertex normals (limit normals where the method has them)
+};
+
+}  // namespace limn::render

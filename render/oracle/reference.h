@@ -1,0 +1,50 @@
+// The exact reference: Embree ray casting of the limit surface, used as the oracle every
+// approximation is measured against.
+//
+// Rays are cast against a dense triangle tessellation of the limit surface (finer near the
+// silhouette, so the outline's chord error projects far below a supersampled pixel); every hit
+// is then moved onto the true surface at its (face, u, v) by Newton steps on the Bfr surface,
+// so depth and normals are exact. Shading uses the limit normal and render/core/shading.h.
+// For Catmull-Clark meshes a second, independent path ray-casts Embree's own subdivision
+// geometry, and the two masks' disagreement is reported.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/core/image.h"
+#include "render/core/passes.h"
+#include "render/subdiv/limit_surface.h"
+
+namespace limn::render::oracle {
+
+struct ReferenceStats {
+  size_t triangles = 0;        // of the dense tessellation
+  size_t raysCast = 0;
+  size_t newtonFailures = 0;   // hits whose refinement did not converge (kept unrefined)
+  double tessellateMs = 0, bvhMs = 0, traceMs = 0;
+};
+
+struct ReferenceResult {
+  ImageSet images;
+  ReferenceStats stats;
+  std::vector<std::string> warnings;
+};
+
+// `passes.supersample` > 0 also fills the supersampled mask. Uses all hardware threads through
+// TBB (Embree's), and checks `cancel` between rows of tiles.
+ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
+                                const PassSelection& passes, const CancelToken& cancel);
+
+// The independent check (Catmull-Clark only): Embree's RTC_GEOMETRY_TYPE_SUBDIVISION with the
+// mesh's creases, corners, holes and boundary mode, cast at the camera's resolution; returns its
+// coverage mask, or nothing with a reason in `whyNot` when Embree cannot represent the mesh
+// (Loop or bilinear schemes, Chaikin creases, non-manifold topology).
+std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
+                                           const Camera& camera, const CancelToken& cancel,
+                                           std::string* whyNot);
+
+}  // namespace limn::render::oracle

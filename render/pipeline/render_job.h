@@ -1,0 +1,94 @@
+// RenderJob -> RenderResult: one request's whole path through the engine, as a straight line:
+// surface = build(mesh); approx = method(surface, camera); images = raster(approx, camera);
+// reference = oracle(surface, camera); metrics = compare(images, reference) + geometry.
+// The api layer builds RenderJobs from JSON and writes RenderResults back; nothing here knows
+// about either.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/core/image.h"
+#include "render/core/passes.h"
+#include "render/mesh/control_mesh.h"
+#include "render/metrics/metrics.h"
+
+namespace limn::render::raster {
+class Rasterizer;
+}
+
+namespace limn::render::pipeline {
+
+enum class Method { Coarse, Uniform, Adaptive, Limit };
+
+struct MethodParams {
+  int level = 3;                // uniform
+  double dicingRate = 1.0;      // adaptive: target edge length in pixels
+  int metricSupersample = 4;    // S for the silhouette metrics
+};
+
+struct Outputs {
+  bool color = true, mask = false, depth = false, normal = false, wireframe = false;
+};
+
+// Limits on what one job may consume; the api layer checks requests against the same values.
+struct JobLimits {
+  mesh::MeshLimits mesh;
+  int maxImageSide = 4096;
+  int maxSupersample = 8;
+  int maxLevel = 6;
+  double minDicingRate = 0.25;
+  size_t maxTriangles = 8'000'000;
+};
+
+struct RenderJob {
+  mesh::ControlMesh mesh;
+  CameraSpec camera;
+  Method method = Method::Adaptive;
+  MethodParams params;
+  Shading shading = Shading::Smooth;
+  Outputs outputs;
+  bool reference = false;
+};
+
+struct Stats {
+  int controlVertices = 0, controlFaces = 0;
+  size_t triangles = 0, vertices = 0;
+  size_t patches = 0;
+  size_t referenceTriangles = 0;
+  // Silhouette Hausdorff distance (output pixels) between the two reference paths
+  // (dense tessellation + Newton vs. Embree's subdivision geometry); absent when not computed.
+  std::optional<double> referenceCrossCheckPx;
+};
+
+struct Timings {
+  double parseMs = 0, surfaceMs = 0, approxMs = 0, rasterMs = 0, referenceMs = 0,
+         metricsMs = 0, totalMs = 0;
+};
+
+struct RenderResult {
+  ImageSet images;                          // the selected outputs of the method
+  std::optional<ImageSet> referenceImages;  // when the job asked for the reference
+  metrics::Metrics metrics;
+  Stats stats;
+  Timings timings;
+  std::vector<std::string> warnings;
+  Camera camera;  // as resolved
+};
+
+// Per-thread resources a job runs with (each worker owns one).
+struct RenderContext {
+  raster::Rasterizer* rasterizer = nullptr;
+};
+
+// Runs the job. Throws InputError for what the request got wrong and Cancelled when `cancel`
+// expires. The engine checks `limits` itself rather than trusting its caller.
+RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& context,
+                 const CancelToken& cancel);
+
+const char* methodName(Method method);
+
+}  // namespace limn::render::pipeline

@@ -1,0 +1,37 @@
+// The approximations of the limit surface that limn draws.
+//   coarse:   the control cage itself, polygons fanned into triangles;
+//   uniform:  the cage refined `level` times (OpenSubdiv's uniform refinement);
+//   adaptive: each face's limit surface tessellated with per-edge rates chosen from the
+//             projected edge length, shared edges sharing their rate and their vertices, so the
+//             mesh is watertight.
+#pragma once
+
+#include <functional>
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/subdiv/limit_surface.h"
+#include "render/tessellate/triangle_mesh.h"
+
+namespace limn::render::tessellate {
+
+TriangleMesh tessellateCoarse(const subdiv::LimitSurface& surface);
+
+// Throws InputError(LimitExceeded, "maxTriangles") if the result would exceed maxTriangles.
+TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
+                               size_t maxTriangles);
+
+struct AdaptiveOptions {
+  double dicingRate = 1.0;  // target edge length in pixels
+  int maxEdgeRate = 128;    // segments per edge at most
+  int minEdgeRate = 1;      // used for faces outside the view or facing away
+  size_t maxTriangles = 8'000'000;
+  // Optional per-face density: the target edge length for face f is dicingRate / density(f).
+  // The reference uses it to tessellate faces near the silhouette more finely.
+  std::function<double(int face)> density;
+};
+
+TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camera& camera,
+                                const AdaptiveOptions& options, const CancelToken& cancel);
+
+}  // namespace limn::render::tessellate

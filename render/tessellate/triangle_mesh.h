@@ -1,0 +1,36 @@
+// TriangleMesh: the output of every method, what raster/ draws and metrics/ measures.
+// Besides positions and normals it remembers where it lies on the limit surface, so the
+// geometric error of any approximation can be measured against the exact surface.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "render/core/vec.h"
+
+namespace limn::render::tessellate {
+
+struct TriangleMesh {
+  std::vector<Vec3f> positions;
+  std::vector<Vec3f> normals;     // per vertex, unit; used for smooth shading
+  std::vector<uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
+
+  // Where each triangle lies on the limit surface: the base face it belongs to and the
+  // (u, v) of its three corners in that face's parameterisation. Filled by methods that
+  // tessellate the limit surface (adaptive, reference); empty otherwise.
+  std::vector<int32_t> triangleFaces;
+  std::vector<Vec2f> cornerUVs;  // three per triangle
+
+  // For meshes whose vertices approximate the limit surface (coarse, uniform): each vertex's
+  // own limit position (the geometry metric compares vertices with these).
+  std::vector<Vec3f> limitPositions;
+
+  // Edges to draw in the wireframe pass, two indices each; empty means "triangle edges".
+  // Coarse and uniform meshes list their polygon edges so quads are drawn as quads.
+  std::vector<uint32_t> lines;
+
+  size_t triangleCount() const { return indices.size() / 3; }
+  size_t vertexCount() const { return positions.size(); }
+};
+
+}  // namespace limn::render::tessellate
