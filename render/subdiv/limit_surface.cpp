@@ -1,0 +1,225 @@
+#include "render/subdiv/limit_surface.h"
+
+#include <cstdio>
+#include <mutex>
+#include <string>
+
+#include <opensubdiv/bfr/refinerSurfaceFactory.h>
+#include <opensubdiv/bfr/surface.h>
+#include <opensubdiv/far/error.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+
+#include "render/core/error.h"
+
+namespace limn::render::subdiv {
+
+namespace Bfr = OpenSubdiv::Bfr;
+namespace Far = OpenSubdiv::Far;
+namespace Sdc = OpenSubdiv::Sdc;
+
+struct LimitSurface::FaceSurface {
+  Bfr::Surface<double> surface;
+  std::vector<double> patchPoints;  // xyz per patch point
+};
+
+namespace {
+
+// Far reports topology errors through one process-wide callback. The last message seen on this
+// thread is kept so the 422 can say what OpenSubdiv objected to.
+thread_local std::string farLastError;
+
+void recordFarError(Far::ErrorType, const char* message) { farLastError = message; }
+
+void installFarErrorCallback() {
+  static std::once_flag once;
+  std::call_once(once, [] { Far::SetErrorCallback(recordFarError); });
+}
+
+Sdc::SchemeType schemeType(mesh::Scheme scheme) {
+  switch (scheme) {
+    case mesh::Scheme::Loop: return Sdc::SCHEME_LOOP;
+    case mesh::Scheme::Bilinear: return Sdc::SCHEME_BILINEAR;
+    case mesh::Scheme::CatmullClark: break;
+  }
+  return Sdc::SCHEME_CATMARK;
+}
+
+Sdc::Options schemeOptions(const mesh::ControlMesh& m) {
+  Sdc::Options options;
+  switch (m.boundary) {
+    case mesh::BoundaryInterpolation::None:
+      options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_NONE);
+      break;
+    case mesh::BoundaryInterpolation::EdgeOnly:
+      options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+      break;
+    case mesh::BoundaryInterpolation::EdgeAndCorner:
+      options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
+      break;
+  }
+  options.SetCreasingMethod(m.creaseMethod == mesh::CreaseMethod::Chaikin
+                                ? Sdc::Options::CREASE_CHAIKIN
+                                : Sdc::Options::CREASE_UNIFORM);
+  options.SetTriangleSubdivision(m.triangleSubdivision == mesh::TriangleSubdivision::Smooth
+                                     ? Sdc::Options::TRI_SUB_SMOOTH
+                                     : Sdc::Options::TRI_SUB_CATMARK);
+  return options;
+}
+
+std::unique_ptr<Far::TopologyRefiner> makeRefiner(const mesh::ControlMesh& m) {
+  installFarErrorCallback();
+  std::vector<int> creaseVertices;
+  std::vector<float> creaseWeights;
+  for (const mesh::Crease& c : m.creases) {
+    creaseVertices.push_back(c.v0);
+    creaseVertices.push_back(c.v1);
+    creaseWeights.push_back(c.sharpness);
+  }
+  std::vector<int> cornerVertices;
+  std::vector<float> cornerWeights;
+  for (const mesh::Corner& c : m.corners) {
+    cornerVertices.push_back(c.vertex);
+    cornerWeights.push_back(c.sharpness);
+  }
+
+  Far::TopologyDescriptor desc;
+  desc.numVertices = m.vertexCount();
+  desc.numFaces = m.faceCount();
+  desc.numVertsPerFace = m.faceVertexCounts.data();
+  desc.vertIndicesPerFace = m.faceVertexIndices.data();
+  desc.numCreases = static_cast<int>(m.creases.size());
+  desc.creaseVertexIndexPairs = creaseVertices.data();
+  desc.creaseWeights = creaseWeights.data();
+  desc.numCorners = static_cast<int>(m.corners.size());
+  desc.cornerVertexIndices = cornerVertices.data();
+  desc.cornerWeights = cornerWeights.data();
+  desc.numHoles = static_cast<int>(m.holes.size());
+  desc.holeIndices = m.holes.data();
+
+  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
+  farLastError.clear();
+  std::unique_ptr<Far::TopologyRefiner> refiner(
+      Factory::Create(desc, Factory::Options(schemeType(m.scheme), schemeOptions(m))));
+  if (!refiner) {
+    throw InputError(InputError::Kind::InvalidMesh, "topology",
+                     "OpenSubdiv rejected the mesh topology" +
+                         (farLastError.empty() ? std::string() : ": " + farLastError));
+  }
+  return refiner;
+}
+
+}  // namespace
+
+LimitSurface::LimitSurface(mesh::ControlMesh mesh)
+    : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(makeRefiner(mesh_)) {
+  buildFaceSurfaces();
+  computeControlLimits();
+}
+
+LimitSurface::~LimitSurface() = default;
+
+std::unique_ptr<Far::TopologyRefiner> LimitSurface::createRefiner() const {
+  return makeRefiner(mesh_);
+}
+
+const Far::TopologyLevel& LimitSurface::baseLevel() const { return refiner_->GetLevel(0); }
+
+void LimitSurface::buildFaceSurfaces() {
+  Bfr::RefinerSurfaceFactory<>::Options options;
+  options.SetApproxLevelSmooth(kApproxLevel);
+  options.SetApproxLevelSharp(kApproxLevel);
+  Bfr::RefinerSurfaceFactory<> factory(*refiner_, options);
+
+  std::vector<double> meshPoints;
+  meshPoints.reserve(mesh_.points.size() * 3);
+  for (const Vec3& p : mesh_.points) {
+    meshPoints.insert(meshPoints.end(), {p.x, p.y, p.z});
+  }
+  const Bfr::Surface<double>::PointDescriptor xyz(3);
+
+  faces_.assign(mesh_.faceCount(), FaceData{});
+  surfaces_.reserve(mesh_.faceCount());
+  for (int f = 0; f < mesh_.faceCount(); ++f) {
+    if (!factory.FaceHasLimitSurface(f)) continue;
+    FaceSurface fs;
+    if (!factory.InitVertexSurface(f, &fs.surface) || !fs.surface.IsValid()) continue;
+    fs.patchPoints.resize(static_cast<size_t>(fs.surface.GetNumPatchPoints()) * 3);
+    fs.surface.PreparePatchPoints(meshPoints.data(), xyz, fs.patchPoints.data(), xyz);
+    faces_[f] = {true, static_cast<int>(surfaces_.size())};
+    surfaces_.push_back(std::move(fs));
+  }
+}
+
+Bfr::Parameterization LimitSurface::parameterization(int face) const {
+  if (faces_[face].valid) return surfaces_[faces_[face].surfaceIndex].surface.GetParameterization();
+  return Bfr::Parameterization(schemeType(mesh_.scheme), mesh_.faceVertexCounts[face]);
+}
+
+Vec2 LimitSurface::cornerUV(int face, int corner) const {
+  double uv[2];
+  parameterization(face).GetVertexCoord(corner, uv);
+  return {uv[0], uv[1]};
+}
+
+Vec2 LimitSurface::centerUV(int face) const {
+  double uv[2];
+  parameterization(face).GetCenterCoord(uv);
+  return {uv[0], uv[1]};
+}
+
+LimitSample LimitSurface::evaluate(int face, double u, double v) const {
+  const FaceSurface& fs = surfaces_[faces_[face].surfaceIndex];
+  const Bfr::Surface<double>::PointDescriptor xyz(3);
+  double uv[2] = {u, v};
+  double p[3], du[3], dv[3];
+  fs.surface.Evaluate(uv, fs.patchPoints.data(), xyz, p, du, dv);
+  LimitSample s;
+  s.position = {p[0], p[1], p[2]};
+  s.du = {du[0], du[1], du[2]};
+  s.dv = {dv[0], dv[1], dv[2]};
+  Vec3 n = cross(s.du, s.dv);
+  double scale = dot(s.du, s.du) + dot(s.dv, s.dv);
+  if (dot(n, n) <= 1e-20 * scale * scale) {
+    // Degenerate derivatives (e.g. at a corner of some irregular patches): the normal there is
+    // the limit of the normals approaching it, taken from a point nudged towards the centre.
+    Vec2 c = centerUV(face);
+    double uvn[2] = {u + (c.x - u) * 1e-5, v + (c.y - v) * 1e-5};
+    fs.surface.Evaluate(uvn, fs.patchPoints.data(), xyz, p, du, dv);
+    n = cross(Vec3{du[0], du[1], du[2]}, Vec3{dv[0], dv[1], dv[2]});
+  }
+  s.normal = normalize(n);
+  return s;
+}
+
+Vec3 LimitSurface::position(int face, double u, double v) const {
+  const FaceSurface& fs = surfaces_[faces_[face].surfaceIndex];
+  const Bfr::Surface<double>::PointDescriptor xyz(3);
+  double uv[2] = {u, v};
+  double p[3];
+  fs.surface.Evaluate(uv, fs.patchPoints.data(), xyz, p);
+  return {p[0], p[1], p[2]};
+}
+
+void LimitSurface::computeControlLimits() {
+  controlLimitPositions_ = mesh_.points;
+  controlLimitNormals_.assign(mesh_.points.size(), Vec3{0, 0, 0});
+  std::vector<bool> done(mesh_.points.size(), false);
+  size_t offset = 0;
+  for (int f = 0; f < mesh_.faceCount(); ++f) {
+    int n = mesh_.faceVertexCounts[f];
+    if (faces_[f].valid) {
+      for (int k = 0; k < n; ++k) {
+        int vertex = mesh_.faceVertexIndices[offset + k];
+        if (done[vertex]) continue;
+        Vec2 uv = cornerUV(f, k);
+        LimitSample s = evaluate(f, uv.x, uv.y);
+        controlLimitPositions_[vertex] = s.position;
+        controlLimitNormals_[vertex] = s.normal;
+        done[vertex] = true;
+      }
+    }
+    offset += n;
+  }
+}
+
+}  // namespace limn::render::subdiv

@@ -1,0 +1,117 @@
+// Small control meshes made by code, shared by unit tests and benchmarks.
+#pragma once
+
+#include <cmath>
+#include <numbers>
+
+#include "render/mesh/control_mesh.h"
+
+namespace limn::testing {
+
+using render::Vec3;
+using render::mesh::ControlMesh;
+using render::mesh::Scheme;
+
+inline void addFace(ControlMesh& m, std::initializer_list<int> vertices) {
+  m.faceVertexCounts.push_back(static_cast<int>(vertices.size()));
+  m.faceVertexIndices.insert(m.faceVertexIndices.end(), vertices);
+}
+
+// Unit cube centred at the origin, faces wound counter-clockwise seen from outside.
+inline ControlMesh cube(Scheme scheme = Scheme::CatmullClark) {
+  ControlMesh m;
+  m.scheme = scheme;
+  m.points = {{-0.5, -0.5, 0.5}, {0.5, -0.5, 0.5},  {-0.5, 0.5, 0.5},  {0.5, 0.5, 0.5},
+              {-0.5, 0.5, -0.5}, {0.5, 0.5, -0.5},  {-0.5, -0.5, -0.5}, {0.5, -0.5, -0.5}};
+  addFace(m, {0, 1, 3, 2});
+  addFace(m, {2, 3, 5, 4});
+  addFace(m, {4, 5, 7, 6});
+  addFace(m, {6, 7, 1, 0});
+  addFace(m, {1, 7, 5, 3});
+  addFace(m, {6, 0, 2, 4});
+  return m;
+}
+
+inline ControlMesh tetrahedron(Scheme scheme = Scheme::Loop) {
+  ControlMesh m;
+  m.scheme = scheme;
+  m.points = {{1, 1, 1}, {-1, -1, 1}, {-1, 1, -1}, {1, -1, -1}};
+  addFace(m, {0, 1, 3});
+  addFace(m, {0, 2, 1});
+  addFace(m, {0, 3, 2});
+  addFace(m, {1, 2, 3});
+  return m;
+}
+
+inline ControlMesh octahedron(Scheme scheme = Scheme::CatmullClark) {
+  ControlMesh m;
+  m.scheme = scheme;
+  m.points = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  addFace(m, {0, 2, 4});
+  addFace(m, {2, 1, 4});
+  addFace(m, {1, 3, 4});
+  addFace(m, {3, 0, 4});
+  addFace(m, {2, 0, 5});
+  addFace(m, {1, 2, 5});
+  addFace(m, {3, 1, 5});
+  addFace(m, {0, 3, 5});
+  return m;
+}
+
+inline ControlMesh icosahedron(Scheme scheme = Scheme::Loop) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  ControlMesh m;
+  m.scheme = scheme;
+  m.points = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+              {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  const int faces[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                            {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                            {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                            {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (const auto& f : faces) addFace(m, {f[0], f[1], f[2]});
+  return m;
+}
+
+// Open grid of n x n quads in the xy plane with a height field, boundary edge-only.
+inline ControlMesh grid(int n, double amplitude = 0.2) {
+  ControlMesh m;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      double x = static_cast<double>(i) / n - 0.5, y = static_cast<double>(j) / n - 0.5;
+      m.points.push_back({x, y, amplitude * std::sin(3.0 * x + 1.0) * std::cos(2.0 * y)});
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      int a = j * (n + 1) + i;
+      addFace(m, {a, a + 1, a + n + 2, a + n + 1});
+    }
+  }
+  return m;
+}
+
+// Torus of `ring` x `tube` quads; with creases, one ring of edges is infinitely sharp and one
+// tube loop semi-sharp (2.0).
+inline ControlMesh torus(int ring = 12, int tube = 8, bool creases = true) {
+  ControlMesh m;
+  const double R = 1.0, r = 0.35;
+  for (int i = 0; i < ring; ++i) {
+    double a = 2 * std::numbers::pi * i / ring;
+    for (int j = 0; j < tube; ++j) {
+      double b = 2 * std::numbers::pi * j / tube;
+      m.points.push_back({(R + r * std::cos(b)) * std::cos(a), (R + r * std::cos(b)) * std::sin(a),
+                          r * std::sin(b)});
+    }
+  }
+  auto id = [&](int i, int j) { return (i % ring) * tube + (j % tube); };
+  for (int i = 0; i < ring; ++i) {
+    for (int j = 0; j < tube; ++j) addFace(m, {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  }
+  if (creases) {
+    for (int i = 0; i < ring; ++i) m.creases.push_back({id(i, 0), id(i + 1, 0), 10.0f});
+    for (int j = 0; j < tube; ++j) m.creases.push_back({id(0, j), id(0, j + 1), 2.0f});
+  }
+  return m;
+}
+
+}  // namespace limn::testing
