@@ -1,0 +1,66 @@
+#include "render/image/pixel_mapping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace limn::render::image {
+
+namespace {
+
+uint8_t quantize(float v) {
+  if (!(v > 0.0f)) return 0;  // also catches NaN
+  if (v >= 1.0f) return 255;
+  return static_cast<uint8_t>(std::lround(v * 255.0f));
+}
+
+std::vector<uint8_t> clamped(const Image& image) {
+  std::vector<uint8_t> out(image.pixels.size());
+  std::transform(image.pixels.begin(), image.pixels.end(), out.begin(), quantize);
+  return out;
+}
+
+// Depth: covered pixels (depth > 0) from white (nearest) to kFarthestDepthGrey (farthest).
+std::vector<uint8_t> depthGrey(const Image& image) {
+  float nearest = std::numeric_limits<float>::infinity();
+  float farthest = 0.0f;
+  for (size_t i = 0; i < image.pixels.size(); i += image.channels) {
+    float d = image.pixels[i];
+    if (d > 0.0f && std::isfinite(d)) {
+      nearest = std::min(nearest, d);
+      farthest = std::max(farthest, d);
+    }
+  }
+  float range = farthest - nearest;
+  std::vector<uint8_t> out(image.pixels.size(), 0);
+  for (size_t i = 0; i < image.pixels.size(); i += image.channels) {
+    float d = image.pixels[i];
+    if (!(d > 0.0f) || !std::isfinite(d)) continue;
+    float t = range > 0.0f ? (d - nearest) / range : 0.0f;
+    out[i] = quantize(1.0f - (1.0f - kFarthestDepthGrey) * t);
+  }
+  return out;
+}
+
+// Normal: RGB = (n + 1) / 2 where the normal has length, black where it is zero (empty).
+std::vector<uint8_t> normalRgb(const Image& image) {
+  std::vector<uint8_t> out(image.pixels.size(), 0);
+  const int c = image.channels;
+  for (size_t i = 0; i < image.pixels.size(); i += c) {
+    float len2 = 0.0f;
+    for (int k = 0; k < std::min(c, 3); ++k) len2 += image.pixels[i + k] * image.pixels[i + k];
+    if (!(len2 > 0.0f)) continue;
+    for (int k = 0; k < c; ++k) out[i + k] = quantize((image.pixels[i + k] + 1.0f) * 0.5f);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<uint8_t> to8Bit(const Image& image, const std::string& passName) {
+  if (passName == pass::kDepth) return depthGrey(image);
+  if (passName == pass::kNormal) return normalRgb(image);
+  return clamped(image);
+}
+
+}  // namespace limn::render::image
