@@ -1,0 +1,264 @@
+// Adaptive tessellation of the limit surface for one camera.
+//
+// 1. Each face is probed at its corners and edge midpoints (Bfr's rate-2 boundary points):
+//    faces entirely outside the view, or facing away on a closed surface, are culled to the
+//    smallest rate.
+// 2. Every edge gets one rate: the largest its faces ask for, a face asking for its edge's
+//    projected length (along the limit curve's corner-midpoint-corner polyline) divided by the
+//    dicing rate and scaled by the face's density.
+// 3. Faces are tessellated independently (Bfr::Tessellation with those edge rates) and
+//    evaluated in parallel.
+// 4. Assembly shares the points of each edge between its faces, so the mesh is watertight by
+//    construction; a shared point gets a second vertex (same position) only where the faces'
+//    normals disagree, as across an infinitely sharp crease.
+#include <opensubdiv/bfr/tessellation.h>
+
+#include <cmath>
+#include <string>
+
+#include "render/core/error.h"
+#include "render/core/parallel.h"
+#include "render/tessellate/tessellate.h"
+
+namespace limn::render::tessellate {
+
+namespace Bfr = OpenSubdiv::Bfr;
+namespace Far = OpenSubdiv::Far;
+
+namespace {
+
+struct FaceProbe {
+  bool culled = true;
+  std::vector<double> edgePixels;  // projected length of each edge
+};
+
+struct FacePatch {
+  std::vector<double> coords;  // (u, v) pairs: boundary points first, then interior
+  std::vector<int> facets;     // triangles, indices into coords
+  std::vector<subdiv::LimitSample> samples;
+  int boundaryCount = 0;
+};
+
+bool isClosed(const subdiv::LimitSurface& surface) {
+  if (!surface.mesh().holes.empty()) return false;
+  const Far::TopologyLevel& base = surface.baseLevel();
+  for (int e = 0; e < base.GetNumEdges(); ++e) {
+    if (base.GetEdgeFaces(e).size() != 2) return false;
+  }
+  return true;
+}
+
+FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera& camera,
+                    bool closed) {
+  FaceProbe probe;
+  Bfr::Parameterization param = surface.parameterization(face);
+  const int n = param.GetFaceSize();
+  Bfr::Tessellation rate2(param, 2);
+  std::vector<double> uv(2 * rate2.GetNumBoundaryCoords());
+  rate2.GetBoundaryCoords(uv.data());  // corner 0, mid of edge 0, corner 1, ...
+
+  std::vector<Vec3> pixel(2 * n);
+  const double margin = 0.05 * std::max(camera.width(), camera.height());
+  bool anyInFront = false, anyFacing = false;
+  double minX = 1e300, maxX = -1e300, minY = 1e300, maxY = -1e300;
+  for (int i = 0; i < 2 * n; ++i) {
+    subdiv::LimitSample s = surface.evaluate(face, uv[2 * i], uv[2 * i + 1]);
+    Vec3 view = camera.viewVector(s.position);
+    if (dot(s.normal, view) < 1e-3 * length(view)) anyFacing = true;
+    pixel[i] = camera.project(s.position);
+    bool inFront = camera.projection() == Projection::Orthographic || pixel[i].z > 0;
+    if (inFront) {
+      anyInFront = true;
+      minX = std::min(minX, pixel[i].x);
+      maxX = std::max(maxX, pixel[i].x);
+      minY = std::min(minY, pixel[i].y);
+      maxY = std::max(maxY, pixel[i].y);
+    }
+  }
+  bool partlyBehind = false;
+  for (const Vec3& p : pixel) {
+    if (camera.projection() == Projection::Perspective && p.z <= camera.nearPlane()) {
+      partlyBehind = true;
+    }
+  }
+  bool outside = !anyInFront || (!partlyBehind && (maxX < -margin || minX > camera.width() + margin ||
+                                                   maxY < -margin || minY > camera.height() + margin));
+  probe.culled = outside || (closed && !anyFacing);
+  probe.edgePixels.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const Vec3& a = pixel[2 * k];
+    const Vec3& m = pixel[2 * k + 1];
+    const Vec3& b = pixel[(2 * k + 2) % (2 * n)];
+    if (partlyBehind) {
+      probe.edgePixels[k] = 1e300;  // crosses the eye plane: as fine as allowed
+    } else {
+      probe.edgePixels[k] = std::hypot(m.x - a.x, m.y - a.y) + std::hypot(b.x - m.x, b.y - m.y);
+    }
+  }
+  return probe;
+}
+
+FacePatch tessellateFace(const subdiv::LimitSurface& surface, int face, const int* rates) {
+  FacePatch patch;
+  Bfr::Parameterization param = surface.parameterization(face);
+  Bfr::Tessellation tess(param, param.GetFaceSize(), rates);
+  patch.boundaryCount = tess.GetNumBoundaryCoords();
+  patch.coords.resize(2 * tess.GetNumCoords());
+  tess.GetCoords(patch.coords.data());
+  patch.facets.resize(3 * tess.GetNumFacets());
+  tess.GetFacets(patch.facets.data());
+  patch.samples.resize(tess.GetNumCoords());
+  for (int i = 0; i < tess.GetNumCoords(); ++i) {
+    patch.samples[i] = surface.evaluate(face, patch.coords[2 * i], patch.coords[2 * i + 1]);
+  }
+  return patch;
+}
+
+// Vertices of the output mesh, shared per surface point and split only where normals differ.
+class VertexPool {
+ public:
+  VertexPool(TriangleMesh& mesh, size_t pointCount) : mesh_(mesh), first_(pointCount, -1) {}
+
+  uint32_t vertexFor(size_t point, const subdiv::LimitSample& sample) {
+    const double kSameNormal = std::cos(1.0 * 3.14159265358979 / 180.0);
+    int v = first_[point];
+    Vec3f position(sample.position);
+    if (v >= 0) {
+      position = mesh_.positions[v];  // the first face's position: exactly shared
+      for (int w = v; w >= 0; w = next_[w]) {
+        if (dot(mesh_.normals[w].toDouble(), sample.normal) >= kSameNormal) return w;
+      }
+    }
+    int created = static_cast<int>(mesh_.positions.size());
+    mesh_.positions.push_back(position);
+    mesh_.normals.emplace_back(sample.normal);
+    next_.push_back(-1);
+    if (v < 0) {
+      first_[point] = created;
+    } else {  // append to the chain of vertices at this point
+      int last = v;
+      while (next_[last] >= 0) last = next_[last];
+      next_[last] = created;
+    }
+    return static_cast<uint32_t>(created);
+  }
+
+  uint32_t uniqueVertex(const subdiv::LimitSample& sample) {
+    mesh_.positions.emplace_back(sample.position);
+    mesh_.normals.emplace_back(sample.normal);
+    next_.push_back(-1);
+    return static_cast<uint32_t>(mesh_.positions.size() - 1);
+  }
+
+ private:
+  TriangleMesh& mesh_;
+  std::vector<int> first_;  // per shared point: its first vertex
+  std::vector<int> next_;   // per vertex: the next vertex at the same point, or -1
+};
+
+}  // namespace
+
+TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camera& camera,
+                                const AdaptiveOptions& options, const CancelToken& cancel) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  const int faceCount = surface.faceCount();
+  const bool closed = isClosed(surface);
+
+  // 1. Probe faces.
+  std::vector<FaceProbe> probes(faceCount);
+  parallelFor(faceCount, 64, [&](size_t begin, size_t end) {
+    cancel.check();
+    for (size_t f = begin; f < end; ++f) {
+      if (surface.hasLimit(static_cast<int>(f))) {
+        probes[f] = probeFace(surface, static_cast<int>(f), camera, closed);
+      }
+    }
+  });
+
+  // 2. One rate per edge.
+  std::vector<int> edgeRate(base.GetNumEdges(), options.minEdgeRate);
+  for (int f = 0; f < faceCount; ++f) {
+    if (!surface.hasLimit(f)) continue;
+    double density = options.density ? options.density(f) : 1.0;
+    Far::ConstIndexArray edges = base.GetFaceEdges(f);
+    for (int k = 0; k < edges.size(); ++k) {
+      int rate = options.minEdgeRate;
+      if (!probes[f].culled) {
+        double segments = std::ceil(probes[f].edgePixels[k] * density / options.dicingRate);
+        rate = static_cast<int>(std::clamp(segments, static_cast<double>(options.minEdgeRate),
+                                           static_cast<double>(options.maxEdgeRate)));
+      }
+      edgeRate[edges[k]] = std::max(edgeRate[edges[k]], rate);
+    }
+  }
+
+  // 3. Tessellate and evaluate every face.
+  std::vector<FacePatch> patches(faceCount);
+  parallelFor(faceCount, 16, [&](size_t begin, size_t end) {
+    cancel.check();
+    std::vector<int> rates;
+    for (size_t f = begin; f < end; ++f) {
+      if (!surface.hasLimit(static_cast<int>(f))) continue;
+      Far::ConstIndexArray edges = base.GetFaceEdges(static_cast<int>(f));
+      rates.resize(edges.size());
+      for (int k = 0; k < edges.size(); ++k) rates[k] = edgeRate[edges[k]];
+      patches[f] = tessellateFace(surface, static_cast<int>(f), rates.data());
+    }
+  });
+  size_t triangles = 0;
+  for (const FacePatch& p : patches) triangles += p.facets.size() / 3;
+  if (triangles > options.maxTriangles) {
+    throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
+                     "adaptive tessellation would make " + std::to_string(triangles) +
+                         " triangles: exceeds limit maxTriangles " +
+                         std::to_string(options.maxTriangles) + " (raise dicingRate)");
+  }
+  cancel.check();
+
+  // 4. Assemble. Shared points: mesh vertices first, then each edge's interior points.
+  std::vector<size_t> edgeFirstPoint(base.GetNumEdges());
+  size_t pointCount = static_cast<size_t>(surface.mesh().vertexCount());
+  for (int e = 0; e < base.GetNumEdges(); ++e) {
+    edgeFirstPoint[e] = pointCount;
+    pointCount += edgeRate[e] - 1;
+  }
+  TriangleMesh out;
+  out.indices.reserve(3 * triangles);
+  out.triangleFaces.reserve(triangles);
+  out.cornerUVs.reserve(3 * triangles);
+  VertexPool pool(out, pointCount);
+  std::vector<uint32_t> vertexOf;
+  for (int f = 0; f < faceCount; ++f) {
+    if (!surface.hasLimit(f)) continue;
+    const FacePatch& patch = patches[f];
+    Far::ConstIndexArray faceVerts = base.GetFaceVertices(f);
+    Far::ConstIndexArray edges = base.GetFaceEdges(f);
+    vertexOf.resize(patch.samples.size());
+    int coord = 0;
+    for (int k = 0; k < edges.size(); ++k) {
+      vertexOf[coord] = pool.vertexFor(faceVerts[k], patch.samples[coord]);
+      ++coord;
+      const int rate = edgeRate[edges[k]];
+      const bool forward = base.GetEdgeVertices(edges[k])[0] == faceVerts[k];
+      for (int i = 1; i < rate; ++i, ++coord) {
+        size_t point = edgeFirstPoint[edges[k]] + (forward ? i - 1 : rate - 1 - i);
+        vertexOf[coord] = pool.vertexFor(point, patch.samples[coord]);
+      }
+    }
+    for (size_t i = coord; i < patch.samples.size(); ++i) {
+      vertexOf[i] = pool.uniqueVertex(patch.samples[i]);
+    }
+    for (size_t t = 0; t < patch.facets.size(); t += 3) {
+      out.triangleFaces.push_back(f);
+      for (int c = 0; c < 3; ++c) {
+        int i = patch.facets[t + c];
+        out.indices.push_back(vertexOf[i]);
+        out.cornerUVs.push_back({static_cast<float>(patch.coords[2 * i]),
+                                 static_cast<float>(patch.coords[2 * i + 1])});
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace limn::render::tessellate

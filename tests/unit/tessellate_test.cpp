@@ -1,0 +1,173 @@
+// Coarse, uniform and adaptive tessellation: counts, watertightness, points on the surface.
+#include "render/tessellate/tessellate.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <tuple>
+
+#include "render/core/error.h"
+#include "tests/unit/test_meshes.h"
+
+namespace limn::render::tessellate {
+namespace {
+
+using Key = std::tuple<float, float, float>;
+Key keyOf(const Vec3f& p) { return {p.x, p.y, p.z}; }
+
+// Counts, for every undirected edge (vertices identified by exact position), how many
+// triangles use it.
+std::map<std::pair<Key, Key>, int> edgeUse(const TriangleMesh& mesh) {
+  std::map<std::pair<Key, Key>, int> use;
+  for (size_t t = 0; t < mesh.indices.size(); t += 3) {
+    for (int c = 0; c < 3; ++c) {
+      Key a = keyOf(mesh.positions[mesh.indices[t + c]]);
+      Key b = keyOf(mesh.positions[mesh.indices[t + (c + 1) % 3]]);
+      ++use[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  return use;
+}
+
+Camera frontCamera(const subdiv::LimitSurface& surface, int size) {
+  CameraSpec spec;
+  spec.width = size;
+  spec.height = size;
+  spec.eye = Vec3{1.2, 1.6, 3.0};
+  return resolveCamera(spec, surface.bounds());
+}
+
+TEST(Coarse, FansPolygonsAndSkipsHoles) {
+  mesh::ControlMesh m = testing::cube();
+  m.holes = {1};
+  subdiv::LimitSurface surface(m);
+  TriangleMesh mesh = tessellateCoarse(surface);
+  EXPECT_EQ(mesh.triangleCount(), 10u);
+  EXPECT_EQ(mesh.limitPositions.size(), 8u);
+  EXPECT_EQ(mesh.lines.size() / 2, 12u);  // every cube edge once, as polygon edges
+}
+
+TEST(Uniform, CountsAndLimitPositions) {
+  subdiv::LimitSurface surface(testing::cube());
+  for (int level : {1, 2, 3}) {
+    TriangleMesh mesh = tessellateUniform(surface, level, 1'000'000);
+    size_t quads = 24u << (2 * (level - 1));
+    EXPECT_EQ(mesh.triangleCount(), 2 * quads) << "level " << level;
+    ASSERT_EQ(mesh.limitPositions.size(), mesh.positions.size());
+  }
+  // The refined vertices converge to their limit positions as the level grows.
+  auto maxGap = [&](int level) {
+    TriangleMesh mesh = tessellateUniform(surface, level, 1'000'000);
+    double gap = 0;
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      gap = std::max(gap, length(mesh.positions[v].toDouble() - mesh.limitPositions[v].toDouble()));
+    }
+    return gap;
+  };
+  EXPECT_LT(maxGap(3), maxGap(1) / 8);
+}
+
+TEST(Uniform, RefusesMoreTrianglesThanTheLimit) {
+  subdiv::LimitSurface surface(testing::cube());
+  try {
+    tessellateUniform(surface, 6, 10'000);
+    FAIL() << "expected LimitExceeded";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), InputError::Kind::LimitExceeded);
+    EXPECT_EQ(e.subject(), "maxTriangles");
+  }
+}
+
+TEST(Uniform, LoopMeshesStayTriangles) {
+  subdiv::LimitSurface surface(testing::icosahedron());
+  EXPECT_EQ(tessellateUniform(surface, 2, 1'000'000).triangleCount(), 20u * 16u);
+}
+
+class AdaptiveWatertight : public ::testing::TestWithParam<int> {};
+
+TEST_P(AdaptiveWatertight, EveryEdgeHasTwoTriangles) {
+  mesh::ControlMesh meshes[] = {testing::cube(), testing::torus(), testing::octahedron(),
+                                testing::icosahedron()};
+  subdiv::LimitSurface surface(meshes[GetParam()]);
+  Camera camera = frontCamera(surface, 256);
+  AdaptiveOptions options;
+  options.dicingRate = 4.0;
+  TriangleMesh mesh = tessellateAdaptive(surface, camera, options, CancelToken());
+  ASSERT_GT(mesh.triangleCount(), 100u);
+  for (const auto& [edge, count] : edgeUse(mesh)) {
+    ASSERT_EQ(count, 2) << "an edge used by " << count << " triangles: the mesh has a crack";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ClosedMeshes, AdaptiveWatertight, ::testing::Values(0, 1, 2, 3));
+
+TEST(Adaptive, VerticesLieOnTheLimitSurface) {
+  subdiv::LimitSurface surface(testing::torus());
+  Camera camera = frontCamera(surface, 256);
+  TriangleMesh mesh = tessellateAdaptive(surface, camera, AdaptiveOptions{}, CancelToken());
+  ASSERT_EQ(mesh.triangleFaces.size(), mesh.triangleCount());
+  double worst = 0;
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    for (int c = 0; c < 3; ++c) {
+      Vec2f uv = mesh.cornerUVs[3 * t + c];
+      Vec3 onSurface = surface.position(mesh.triangleFaces[t], uv.x, uv.y);
+      worst = std::max(worst, length(onSurface - mesh.positions[mesh.indices[3 * t + c]].toDouble()));
+    }
+  }
+  EXPECT_LT(worst, 1e-5);
+}
+
+TEST(Adaptive, EdgesAreAboutTheDicingRateOnScreen) {
+  subdiv::LimitSurface surface(testing::cube());
+  Camera camera = frontCamera(surface, 512);
+  for (double rate : {1.0, 4.0}) {
+    AdaptiveOptions options;
+    options.dicingRate = rate;
+    TriangleMesh mesh = tessellateAdaptive(surface, camera, options, CancelToken());
+    std::vector<double> lengths;
+    for (size_t t = 0; t < mesh.indices.size(); t += 3) {
+      Vec3 a = camera.project(mesh.positions[mesh.indices[t]].toDouble());
+      Vec3 b = camera.project(mesh.positions[mesh.indices[t + 1]].toDouble());
+      lengths.push_back(std::hypot(a.x - b.x, a.y - b.y));
+    }
+    std::sort(lengths.begin(), lengths.end());
+    double median = lengths[lengths.size() / 2];
+    EXPECT_GT(median, 0.3 * rate) << "rate " << rate;
+    EXPECT_LT(median, 1.5 * rate) << "rate " << rate;
+  }
+}
+
+TEST(Adaptive, FinerDicingMakesMoreTriangles) {
+  subdiv::LimitSurface surface(testing::torus());
+  Camera camera = frontCamera(surface, 512);
+  AdaptiveOptions coarse, fine;
+  coarse.dicingRate = 8;
+  fine.dicingRate = 2;
+  size_t a = tessellateAdaptive(surface, camera, coarse, CancelToken()).triangleCount();
+  size_t b = tessellateAdaptive(surface, camera, fine, CancelToken()).triangleCount();
+  EXPECT_GT(b, 8 * a);
+}
+
+TEST(Adaptive, SharpCreaseSplitsNormalsButNotPositions) {
+  subdiv::LimitSurface surface(testing::torus(12, 8, true));
+  Camera camera = frontCamera(surface, 256);
+  TriangleMesh mesh = tessellateAdaptive(surface, camera, AdaptiveOptions{}, CancelToken());
+  std::map<Key, int> verticesAt;
+  for (const Vec3f& p : mesh.positions) ++verticesAt[keyOf(p)];
+  int split = 0;
+  for (const auto& [key, count] : verticesAt) split += count > 1;
+  EXPECT_GT(split, 0) << "the infinitely sharp crease should carry two normals";
+}
+
+TEST(Adaptive, RespectsTheTriangleLimit) {
+  subdiv::LimitSurface surface(testing::torus());
+  Camera camera = frontCamera(surface, 1024);
+  AdaptiveOptions options;
+  options.dicingRate = 0.5;
+  options.maxTriangles = 1000;
+  EXPECT_THROW(tessellateAdaptive(surface, camera, options, CancelToken()), InputError);
+}
+
+}  // namespace
+}  // namespace limn::render::tessellate
