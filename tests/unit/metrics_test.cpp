@@ -1,0 +1,382 @@
+// Tests of render/metrics: the distance transform against brute force, the silhouette metrics
+// on masks whose answers are known by construction, the per-pixel image metrics on hand-made
+// ImageSets, and the geometry metric against a real OpenSubdiv limit surface.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "render/metrics/metrics.h"
+
+namespace limn::render::metrics {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+
+Image disc(int size, double cx, double cy, double radius) {
+  Image mask(size, size, 1);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
+      mask.at(x, y) = dx * dx + dy * dy <= radius * radius ? 1.0f : 0.0f;
+    }
+  }
+  return mask;
+}
+
+Image rectangle(int width, int height, int x0, int y0, int x1, int y1) {
+  Image mask(width, height, 1);
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) mask.at(x, y) = 1.0f;
+  }
+  return mask;
+}
+
+bool coveredAt(const Image& m, int x, int y) {
+  return x >= 0 && y >= 0 && x < m.width && y < m.height && m.at(x, y) > 0.5f;
+}
+
+// The definition, written out the slow way: covered with an uncovered 4-neighbour or on the
+// border.
+std::vector<std::pair<int, int>> bruteSilhouette(const Image& m) {
+  std::vector<std::pair<int, int>> out;
+  for (int y = 0; y < m.height; ++y) {
+    for (int x = 0; x < m.width; ++x) {
+      if (!coveredAt(m, x, y)) continue;
+      if (!coveredAt(m, x - 1, y) || !coveredAt(m, x + 1, y) || !coveredAt(m, x, y - 1) ||
+          !coveredAt(m, x, y + 1)) {
+        out.push_back({x, y});
+      }
+    }
+  }
+  return out;
+}
+
+// Max and sum of the distances from each pixel of `from` to its nearest pixel of `to`.
+std::pair<double, double> bruteDirected(const std::vector<std::pair<int, int>>& from,
+                                        const std::vector<std::pair<int, int>>& to) {
+  double worst = 0, sum = 0;
+  for (auto [ax, ay] : from) {
+    double best = std::numeric_limits<double>::infinity();
+    for (auto [bx, by] : to) best = std::min(best, std::hypot(ax - bx, ay - by));
+    worst = std::max(worst, best);
+    sum += best;
+  }
+  return {worst, sum};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Distance transform
+
+TEST(DistanceTransform, MatchesBruteForceOnRandomImages) {
+  std::mt19937 rng(12345);
+  const int sizes[][2] = {{1, 1}, {1, 17}, {23, 1}, {7, 5}, {31, 29}, {64, 48}, {50, 3}};
+  for (auto [w, h] : sizes) {
+    for (double density : {0.002, 0.02, 0.2, 0.7}) {
+      std::bernoulli_distribution isFeature(density);
+      std::vector<bool> features(static_cast<size_t>(w) * h);
+      for (size_t i = 0; i < features.size(); ++i) features[i] = isFeature(rng);
+      const std::vector<double> edt = squaredDistanceTransform(features, w, h);
+      ASSERT_EQ(edt.size(), features.size());
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          double best = std::numeric_limits<double>::infinity();
+          for (int fy = 0; fy < h; ++fy) {
+            for (int fx = 0; fx < w; ++fx) {
+              if (features[fy * w + fx]) {
+                best = std::min(best, double((x - fx) * (x - fx) + (y - fy) * (y - fy)));
+              }
+            }
+          }
+          ASSERT_EQ(edt[y * w + x], best)
+              << "pixel (" << x << "," << y << ") of " << w << "x" << h << " density " << density;
+        }
+      }
+    }
+  }
+}
+
+TEST(DistanceTransform, SingleFeatureGivesSquaredEuclideanDistance) {
+  const int w = 9, h = 6;
+  std::vector<bool> features(w * h, false);
+  features[2 * w + 7] = true;  // (7, 2)
+  const std::vector<double> edt = squaredDistanceTransform(features, w, h);
+  EXPECT_EQ(edt[2 * w + 7], 0.0);
+  EXPECT_EQ(edt[0], 49.0 + 4.0);
+  EXPECT_EQ(edt[5 * w + 0], 49.0 + 9.0);
+  EXPECT_EQ(edt[5 * w + 8], 1.0 + 9.0);
+}
+
+TEST(DistanceTransform, NoFeatureIsInfinityEverywhere) {
+  const std::vector<double> edt = squaredDistanceTransform(std::vector<bool>(12, false), 4, 3);
+  for (double d : edt) EXPECT_TRUE(std::isinf(d) && d > 0);
+}
+
+TEST(DistanceTransform, RejectsBufferOfWrongSize) {
+  EXPECT_THROW(squaredDistanceTransform(std::vector<bool>(11, false), 4, 3),
+               std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Silhouettes
+
+TEST(Silhouette, IdenticalMasksAgreeExactly) {
+  const Image a = disc(200, 100, 100, 60);
+  const SilhouetteMetrics m = compareSilhouettes(a, a, 1);
+  EXPECT_EQ(m.hausdorffPx, 0.0);
+  EXPECT_EQ(m.meanPx, 0.0);
+  EXPECT_EQ(m.iou, 1.0);
+  EXPECT_EQ(m.mismatchPx, 0);
+}
+
+TEST(Silhouette, ConcentricDiscsAreTheirRadiusDifferenceApart) {
+  const Image a = disc(256, 128, 128, 100);
+  const Image b = disc(256, 128, 128, 103);
+  const SilhouetteMetrics m = compareSilhouettes(a, b, 1);
+  EXPECT_NEAR(m.hausdorffPx, 3.0, 1.0);
+  EXPECT_NEAR(m.meanPx, 3.0, 1.0);
+  EXPECT_NEAR(m.iou, (100.0 * 100.0) / (103.0 * 103.0), 0.01);
+  // The ring between the circles: pi (103^2 - 100^2) pixels.
+  EXPECT_NEAR(m.mismatchPx, 3.14159 * (103 * 103 - 100 * 100), 60);
+  // Symmetric in its arguments.
+  const SilhouetteMetrics r = compareSilhouettes(b, a, 1);
+  EXPECT_EQ(r.hausdorffPx, m.hausdorffPx);
+  EXPECT_EQ(r.meanPx, m.meanPx);
+  EXPECT_EQ(r.iou, m.iou);
+  EXPECT_EQ(r.mismatchPx, m.mismatchPx);
+}
+
+TEST(Silhouette, ShiftedSquareIsShiftApartInOutputPixels) {
+  for (int k : {1, 3, 7}) {
+    const Image a = rectangle(160, 120, 40, 30, 100, 90);
+    const Image b = rectangle(160, 120, 40 + k, 30, 100 + k, 90);
+    const SilhouetteMetrics m = compareSilhouettes(a, b, 1);
+    EXPECT_DOUBLE_EQ(m.hausdorffPx, k) << "shift " << k;
+    EXPECT_GT(m.meanPx, 0.0);
+    EXPECT_LT(m.meanPx, k);  // the top and bottom edges mostly overlap
+    EXPECT_DOUBLE_EQ(m.iou, (60.0 - k) * 60.0 / ((60.0 + k) * 60.0));
+    EXPECT_EQ(m.mismatchPx, 2 * k * 60);
+  }
+}
+
+TEST(Silhouette, SupersampleDividesDistancesIntoOutputPixels) {
+  const int s = 4, k = 6;  // a shift of 6 supersampled pixels is 1.5 output pixels
+  const Image a = rectangle(64 * s, 48 * s, 10 * s, 10 * s, 40 * s, 30 * s);
+  const Image b = rectangle(64 * s, 48 * s, 10 * s + k, 10 * s, 40 * s + k, 30 * s);
+  const SilhouetteMetrics m = compareSilhouettes(a, b, s);
+  EXPECT_DOUBLE_EQ(m.hausdorffPx, 1.5);
+  // a covers output columns 10..39. b starts 6 pixels later: column 10 is empty in b, column 11
+  // is 2/4 covered (not a majority), column 40 is full and 41 is 2/4. So columns 10, 11 and 40
+  // differ, over 20 rows.
+  EXPECT_EQ(m.mismatchPx, 3 * 20);
+}
+
+TEST(Silhouette, MatchesBruteForceOnRandomShapes) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int w = 24 + trial * 3, h = 40 - trial;
+    Image a(w, h, 1), b(w, h, 1);
+    for (Image* m : {&a, &b}) {
+      for (int blob = 0; blob < 3; ++blob) {
+        const double cx = unit(rng) * w, cy = unit(rng) * h, r = 2 + unit(rng) * 8;
+        for (int y = 0; y < h; ++y) {
+          for (int x = 0; x < w; ++x) {
+            if (std::hypot(x + 0.5 - cx, y + 0.5 - cy) <= r) m->at(x, y) = 0.9f;
+          }
+        }
+      }
+    }
+    const auto sa = bruteSilhouette(a), sb = bruteSilhouette(b);
+    if (sa.empty() || sb.empty()) continue;
+    const auto [maxAB, sumAB] = bruteDirected(sa, sb);
+    const auto [maxBA, sumBA] = bruteDirected(sb, sa);
+    const SilhouetteMetrics m = compareSilhouettes(a, b, 1);
+    EXPECT_NEAR(m.hausdorffPx, std::max(maxAB, maxBA), 1e-12) << "trial " << trial;
+    EXPECT_NEAR(m.meanPx, (sumAB + sumBA) / double(sa.size() + sb.size()), 1e-12)
+        << "trial " << trial;
+  }
+}
+
+TEST(Silhouette, ImageBorderCountsAsUncovered) {
+  // A mask covering everything has its contour on the border; one that leaves a one-pixel
+  // frame has its contour one pixel inside. Every contour pixel of either is 1 pixel from the
+  // other contour, except the 4 image corners, sqrt(2) from the inset's corners.
+  const Image full(50, 40, 1, 1.0f);
+  const Image inset = rectangle(50, 40, 1, 1, 49, 39);
+  EXPECT_EQ(compareSilhouettes(full, full, 1).hausdorffPx, 0.0);
+  const SilhouetteMetrics m = compareSilhouettes(full, inset, 1);
+  EXPECT_DOUBLE_EQ(m.hausdorffPx, std::sqrt(2.0));
+  const int borderPixels = 2 * 50 + 2 * 38, ringPixels = 2 * 48 + 2 * 36;
+  EXPECT_DOUBLE_EQ(m.meanPx, (borderPixels - 4 + 4 * std::sqrt(2.0) + ringPixels) /
+                                 (borderPixels + ringPixels));
+}
+
+TEST(Silhouette, IouAndMismatchOnHandMadeMasks) {
+  // 4x2 output pixels at S = 2 (8x4 mask). Block coverage counts in a / b:
+  //   block (0,0): 4 / 4   block (1,0): 3 / 2   block (2,0): 2 / 3   block (3,0): 0 / 1
+  //   block (0,1): 1 / 0   others 0 / 0
+  Image a(8, 4, 1), b(8, 4, 1);
+  auto set = [](Image& m, std::initializer_list<std::pair<int, int>> pixels) {
+    for (auto [x, y] : pixels) m.at(x, y) = 1.0f;
+  };
+  set(a, {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, {3, 0}, {2, 1}, {4, 0}, {5, 0}, {0, 2}});
+  set(b, {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, {3, 1}, {4, 0}, {5, 0}, {4, 1}, {7, 1}});
+  // Both: (0,0) (1,0) (0,1) (1,1) (2,0) (4,0) (5,0) = 7; either: 10 + 10 - 7 = 13.
+  const SilhouetteMetrics m = compareSilhouettes(a, b, 2);
+  EXPECT_DOUBLE_EQ(m.iou, 7.0 / 13.0);
+  // Majority (> 2 of 4): a covers blocks (0,0) and (1,0); b covers (0,0) and (2,0).
+  EXPECT_EQ(m.mismatchPx, 2);
+}
+
+TEST(Silhouette, EmptyMasks) {
+  const Image empty(40, 30, 1);
+  const SilhouetteMetrics both = compareSilhouettes(empty, empty, 2);
+  EXPECT_EQ(both.hausdorffPx, 0.0);
+  EXPECT_EQ(both.meanPx, 0.0);
+  EXPECT_EQ(both.iou, 1.0);
+  EXPECT_EQ(both.mismatchPx, 0);
+
+  // Object in one image only: the distance is the image diagonal in output pixels (20 x 15).
+  const Image some = rectangle(40, 30, 10, 10, 20, 20);
+  const SilhouetteMetrics one = compareSilhouettes(some, empty, 2);
+  EXPECT_DOUBLE_EQ(one.hausdorffPx, 25.0);
+  EXPECT_EQ(one.iou, 0.0);
+  EXPECT_EQ(one.mismatchPx, 25);
+  EXPECT_DOUBLE_EQ(compareSilhouettes(empty, some, 2).hausdorffPx, 25.0);
+}
+
+TEST(Silhouette, RejectsMismatchedMasks) {
+  EXPECT_THROW(compareSilhouettes(Image(8, 8, 1), Image(8, 4, 1), 1), std::invalid_argument);
+  EXPECT_THROW(compareSilhouettes(Image(8, 8, 1), Image(8, 8, 1), 3), std::invalid_argument);
+  EXPECT_THROW(compareSilhouettes(Image(8, 8, 1), Image(8, 8, 1), 0), std::invalid_argument);
+  EXPECT_THROW(compareSilhouettes(Image(8, 8, 4), Image(8, 8, 4), 1), std::invalid_argument);
+}
+
+// Not a timed test (that would fail on a slow day): it checks the answer at the largest size
+// the service uses by default (1024^2 output at S = 4) and prints how long it took.
+TEST(Silhouette, LargeSupersampledMasks) {
+  const int s = 4, size = 1024 * s;
+  const Image a = disc(size, size / 2.0, size / 2.0, 1500.0);
+  const Image b = disc(size, size / 2.0 + 0.3, size / 2.0, 1504.0);
+  const auto start = std::chrono::steady_clock::now();
+  const SilhouetteMetrics m = compareSilhouettes(a, b, s);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("compareSilhouettes %dx%d (S=%d): %.1f ms\n", size, size, s, ms);
+  RecordProperty("compareSilhouettesMs", std::to_string(ms));
+  EXPECT_NEAR(m.hausdorffPx, 4.3 / s, 1.0 / s);
+  EXPECT_NEAR(m.iou, (1500.0 * 1500.0) / (1504.0 * 1504.0), 1e-3);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Color, depth, normals
+
+// A w x h rendering with a mask pass and uniform passes.
+ImageSet rendering(int w, int h) {
+  ImageSet set;
+  set.passes[pass::kMask] = Image(w, h, 1, 1.0f);
+  Image color(w, h, 4, 0.5f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) color.at(x, y, 3) = 1.0f;
+  }
+  set.passes[pass::kColor] = color;
+  set.passes[pass::kDepth] = Image(w, h, 1, 3.0f);
+  Image normal(w, h, 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) normal.at(x, y, 2) = 1.0f;
+  }
+  set.passes[pass::kNormal] = normal;
+  return set;
+}
+
+TEST(Color, RmseOverPixelsCoveredInEither) {
+  ImageSet a = rendering(2, 2), b = rendering(2, 2);
+  // Pixel (1,1) is covered in neither: its huge difference must not count.
+  a.passes[pass::kMask].at(1, 1) = 0;
+  b.passes[pass::kMask].at(1, 1) = 0;
+  b.passes[pass::kColor].at(1, 1, 0) = 1.0f;
+  // Pixel (1,0) is covered only in the reference: it counts.
+  a.passes[pass::kMask].at(1, 0) = 0;
+  b.passes[pass::kColor].at(1, 0, 0) = 0.8f;
+  // Alpha differs too, but only RGB counts.
+  b.passes[pass::kColor].at(0, 0, 3) = 0.0f;
+  const ColorMetrics m = compareColor(a, b);
+  // One channel of three pixels off by 0.3: sqrt(0.09 / 9) = 0.1, PSNR 20 dB.
+  EXPECT_NEAR(m.rmse, 0.1, 1e-6);
+  EXPECT_NEAR(m.psnr, 20.0, 1e-4);
+}
+
+TEST(Color, WithoutMaskPassAlphaTellsCoverage) {
+  ImageSet a = rendering(2, 1), b = rendering(2, 1);
+  a.passes.erase(pass::kMask);
+  b.passes.erase(pass::kMask);
+  a.passes.erase(pass::kDepth);
+  b.passes.erase(pass::kDepth);
+  a.passes[pass::kColor].at(1, 0, 3) = 0.0f;  // uncovered in both
+  b.passes[pass::kColor].at(1, 0, 3) = 0.0f;
+  b.passes[pass::kColor].at(1, 0, 1) = 0.0f;
+  b.passes[pass::kColor].at(0, 0, 2) = 0.5f + 0.2f;
+  EXPECT_NEAR(compareColor(a, b).rmse, std::sqrt(0.04 / 3), 1e-6);
+}
+
+TEST(Color, IdenticalImagesHaveCappedPsnr) {
+  const ImageSet a = rendering(3, 3);
+  const ColorMetrics m = compareColor(a, a);
+  EXPECT_EQ(m.rmse, 0.0);
+  EXPECT_EQ(m.psnr, 100.0);
+}
+
+TEST(Color, MissingOrMismatchedPassesAreRejected) {
+  ImageSet a = rendering(2, 2), b = rendering(2, 2);
+  b.passes.erase(pass::kColor);
+  EXPECT_THROW(compareColor(a, b), std::invalid_argument);
+  EXPECT_THROW(compareColor(a, rendering(3, 2)), std::invalid_argument);
+}
+
+TEST(Depth, RelativeToDiagonalOverPixelsCoveredInBoth) {
+  ImageSet a = rendering(2, 2), b = rendering(2, 2);
+  b.passes[pass::kDepth].at(0, 0) = 3.5f;   // covered in both: counts
+  b.passes[pass::kDepth].at(1, 0) = 3.25f;  // covered in both: counts
+  a.passes[pass::kMask].at(0, 1) = 0;       // covered in the reference only: ignored
+  b.passes[pass::kDepth].at(0, 1) = 9.0f;
+  const DepthMetrics m = compareDepth(a, b, 2.0);
+  EXPECT_NEAR(m.maxRel, 0.25, 1e-7);
+  EXPECT_NEAR(m.meanRel, (0.5 + 0.25) / 3 / 2.0, 1e-7);
+  EXPECT_THROW(compareDepth(a, b, 0.0), std::invalid_argument);
+}
+
+TEST(Normals, AngleBetweenNormalisedNormals) {
+  ImageSet a = rendering(3, 1), b = rendering(3, 1);
+  Image& na = a.passes[pass::kNormal];
+  Image& nb = b.passes[pass::kNormal];
+  // (0,0,1) vs (1,0,0): 90 degrees.
+  nb.at(0, 0, 0) = 1, nb.at(0, 0, 2) = 0;
+  // Unnormalised (0,0,2) vs (0,1,1): 45 degrees.
+  na.at(1, 0, 2) = 2, nb.at(1, 0, 1) = 1;
+  // A tiny angle, measured accurately: 1e-4 radians.
+  nb.at(2, 0, 1) = static_cast<float>(std::tan(1e-4));
+  const NormalMetrics m = compareNormals(a, b);
+  EXPECT_NEAR(m.maxDeg, 90.0, 1e-4);
+  EXPECT_NEAR(m.meanDeg, (90.0 + 45.0 + 1e-4 * 180.0 / M_PI) / 3, 1e-4);
+
+  // Opposite normals: 180 degrees, not NaN.
+  ImageSet c = rendering(1, 1), d = rendering(1, 1);
+  d.passes[pass::kNormal].at(0, 0, 2) = -1;
+  EXPECT_NEAR(compareNormals(c, d).maxDeg, 180.0, 1e-9);
+}
+
+TEST(Normals, SmallAnglePrecision) {
+  ImageSet a = rendering(1, 1), b = rendering(1, 1);
+  b.passes[pass::kNormal].at(0, 0, 0) = static_cast<float>(std::tan(1e-4));
+  EXPECT_NEAR(compareNormals(a, b).maxDeg, 1e-4 * 180.0 / M_PI, 1e-7);
+}
+
+}  // namespace
+}  // namespace limn::render::metrics
