@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# One command from a fresh Debian 12 machine to every test: installs what is missing, builds,
+# and runs the unit and integration tests (the real server on 127.0.0.1) through CTest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+scripts/build.sh
+cd build
+ctest --output-on-failure -j "${LIMN_TEST_JOBS:-1}" "$@"
