@@ -21,31 +21,40 @@ constexpr int kColumnStripe = 256;
 constexpr int kRowGrain = 16;
 }  // namespace
 
-ColumnDistances::ColumnDistances(const std::vector<uint8_t>& features, int width, int height)
-    : width_(width), height_(height) {
-  if (width < 0 || height < 0 ||
-      features.size() != static_cast<size_t>(width) * static_cast<size_t>(height)) {
-    throw std::invalid_argument("distance transform: feature buffer does not match its size");
+ColumnDistances::ColumnDistances(int width, int height) : width_(width), height_(height) {
+  if (width < 0 || height < 0 || height > kMaxSide) {
+    throw std::invalid_argument("distance transform: image height " + std::to_string(height) +
+                                " is outside 0.." + std::to_string(kMaxSide));
   }
-  distances_.resize(features.size());
-  if (width == 0 || height == 0) return;
+  distances_.reset(new uint16_t[static_cast<size_t>(width) * static_cast<size_t>(height)]);
+}
+
+void ColumnDistances::compute(const uint8_t* pixels, uint8_t featureBits) {
+  if (width_ == 0 || height_ == 0) return;
   // Rows are walked in order inside a stripe of columns, so memory is read forwards. A column
-  // without features counts up from `height`, which keeps it >= height: noFeature().
-  tbb::parallel_for(tbb::blocked_range<int>(0, width, kColumnStripe),
-                    [&](const tbb::blocked_range<int>& stripe) {
-    const int x0 = stripe.begin(), x1 = stripe.end();
-    const size_t w = static_cast<size_t>(width);
-    for (int x = x0; x < x1; ++x) distances_[x] = features[x] ? 0 : height;
-    for (int y = 1; y < height; ++y) {
-      const uint8_t* f = features.data() + y * w;
-      int32_t* d = distances_.data() + y * w;
-      const int32_t* above = d - w;
-      for (int x = x0; x < x1; ++x) d[x] = f[x] ? 0 : above[x] + 1;
+  // without features saturates at `height`: noFeature().
+  const size_t w = static_cast<size_t>(width_);
+  const uint16_t none = static_cast<uint16_t>(height_);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, w, kColumnStripe),
+                    [&](const tbb::blocked_range<size_t>& stripe) {
+    const size_t x0 = stripe.begin(), x1 = stripe.end();
+    for (size_t x = x0; x < x1; ++x) distances_[x] = (pixels[x] & featureBits) ? 0 : none;
+    for (size_t y = 1; y < static_cast<size_t>(height_); ++y) {
+      const uint8_t* f = pixels + y * w;
+      uint16_t* d = distances_.get() + y * w;
+      const uint16_t* above = d - w;
+      for (size_t x = x0; x < x1; ++x) {
+        // Computed in int: at height 65535, none + 1 does not fit 16 bits.
+        const uint16_t next = static_cast<uint16_t>(std::min<int>(above[x] + 1, none));
+        d[x] = (f[x] & featureBits) ? 0 : next;
+      }
     }
-    for (int y = height - 2; y >= 0; --y) {
-      int32_t* d = distances_.data() + y * w;
-      const int32_t* below = d + w;
-      for (int x = x0; x < x1; ++x) d[x] = std::min(d[x], below[x] + 1);
+    for (size_t y = static_cast<size_t>(height_) - 1; y-- > 0;) {
+      uint16_t* d = distances_.get() + y * w;
+      const uint16_t* below = d + w;
+      for (size_t x = x0; x < x1; ++x) {
+        d[x] = static_cast<uint16_t>(std::min<int>(d[x], below[x] + 1));
+      }
     }
   });
 }
@@ -57,7 +66,7 @@ bool RowEnvelope::build(const ColumnDistances& columns, int y) {
     heights_.resize(width + 1);
     boundaries_.resize(width + 1);
   }
-  const int32_t* g = columns.row(y);
+  const uint16_t* g = columns.row(y);
   int k = -1;
   for (int q = 0; q < width; ++q) {
     if (columns.noFeature(g[q])) continue;
@@ -105,7 +114,8 @@ std::vector<double> squaredDistanceTransform(const std::vector<bool>& isFeature,
                                 std::to_string(width) + "x" + std::to_string(height) + " image");
   }
   std::vector<uint8_t> features(isFeature.begin(), isFeature.end());
-  const ColumnDistances columns(features, width, height);
+  ColumnDistances columns(width, height);
+  columns.compute(features.data(), 1);
   std::vector<double> result(features.size(), std::numeric_limits<double>::infinity());
   tbb::parallel_for(tbb::blocked_range<int>(0, height, kRowGrain),
                     [&](const tbb::blocked_range<int>& rows) {

@@ -2,34 +2,48 @@
 // "Distance Transforms of Sampled Functions"), kept apart so callers can stop half-way.
 //
 // Pass 1 (ColumnDistances) gives every pixel the distance to the nearest feature in its own
-// column. Pass 2 (RowEnvelope) takes one row of those, builds the lower envelope of the
-// parabolas (x - q)^2 + g(q)^2 and reads the exact squared 2D distance off it, left to right.
+// column (for a binary image that is what the 1D transform of the first dimension computes).
+// Pass 2 (RowEnvelope) takes one row of those, builds the lower envelope of the parabolas
+// (x - q)^2 + g(q)^2 and reads the exact squared 2D distance off it, left to right.
 // squaredDistanceTransform() in metrics.h runs both over the whole image; the silhouette
-// metric runs pass 2 only on rows where it needs answers, which on a sparse contour is most of
-// the saving.
+// metric runs pass 2 only on rows where it needs answers, which on a sparse contour saves most
+// of the second pass.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace limn::render::metrics {
 
 // Pass 1: per-column distance (in pixels) from each pixel to the nearest feature pixel of its
-// column. `features` is row-major, nonzero = feature. Columns without any feature get values
-// >= height (noFeature()). Runs in parallel over column stripes.
+// column; columns without any feature hold `height` (noFeature()). Distances are 16-bit to
+// halve the memory traffic, so images may be at most kMaxSide pixels tall. Runs in parallel
+// over column stripes. One instance can be recomputed for several feature sets of the same
+// size, which saves allocating (and page-faulting) its buffer again.
 class ColumnDistances {
  public:
-  ColumnDistances(const std::vector<uint8_t>& features, int width, int height);
+  static constexpr int kMaxSide = 65535;
+
+  // Throws std::invalid_argument when height exceeds kMaxSide.
+  ColumnDistances(int width, int height);
+
+  // `pixels` is row-major, width x height bytes; a pixel is a feature when (byte & featureBits)
+  // is non-zero, so one byte can carry flags for several feature sets.
+  void compute(const uint8_t* pixels, uint8_t featureBits);
 
   int width() const { return width_; }
   int height() const { return height_; }
-  const int32_t* row(int y) const { return distances_.data() + static_cast<size_t>(y) * width_; }
-  bool noFeature(int32_t g) const { return g >= height_; }
+  const uint16_t* row(int y) const {
+    return distances_.get() + static_cast<size_t>(y) * static_cast<size_t>(width_);
+  }
+  bool noFeature(uint16_t g) const { return g >= height_; }
 
  private:
   int width_, height_;
-  std::vector<int32_t> distances_;
+  // Left uninitialised until compute(): its parallel first touch is cheaper than a serial fill.
+  std::unique_ptr<uint16_t[]> distances_;
 };
 
 // Pass 2 for one row: the lower envelope of the parabolas rooted at the row's columns that have
@@ -45,9 +59,9 @@ class RowEnvelope {
   int64_t squaredDistanceAt(int x);
 
  private:
-  std::vector<int32_t> roots_;       // columns whose parabola is part of the envelope
-  std::vector<int64_t> heights_;     // their g^2
-  std::vector<double> boundaries_;   // boundaries_[k]: where parabola k starts to be lowest
+  std::vector<int32_t> roots_;      // columns whose parabola is part of the envelope
+  std::vector<int64_t> heights_;    // their g^2
+  std::vector<double> boundaries_;  // boundaries_[k]: where parabola k starts to be lowest
   int count_ = 0;
   int cursor_ = 0;
 };
