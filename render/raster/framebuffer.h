@@ -1,0 +1,47 @@
+// Framebuffer: an offscreen framebuffer object with a fixed list of colour attachments (one
+// renderbuffer each, in the given internal formats) and optionally a float depth buffer.
+// Storage is (re)allocated only when the requested size changes, so a Rasterizer that renders
+// the same size again reuses it.
+#pragma once
+
+#include <vector>
+
+#include "render/raster/gl_api.h"
+
+namespace limn::render::raster {
+
+class Framebuffer {
+ public:
+  Framebuffer(std::vector<GLenum> colorFormats, bool withDepth);
+  ~Framebuffer();
+  Framebuffer(const Framebuffer&) = delete;
+  Framebuffer& operator=(const Framebuffer&) = delete;
+
+  // Makes the attachments width x height (no-op when they already are) and binds the
+  // framebuffer for drawing with a matching viewport.
+  void bind(int width, int height);
+
+  // Chooses which attachments the fragment outputs 0..n-1 write to; false means "none".
+  void setDrawBuffers(const std::vector<bool>& enabled);
+  void clearColor(int attachment, const float value[4]);
+  void clearDepth(float value);
+
+  // Reads attachment `attachment` as floats, `components` per pixel (GL_RED: 1, GL_RGBA: 4),
+  // bottom row first as OpenGL stores it.
+  void read(int attachment, GLenum format, std::vector<float>& out) const;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  void allocate(int width, int height);
+
+  std::vector<GLenum> colorFormats_;
+  bool withDepth_;
+  GLuint framebuffer_ = 0;
+  std::vector<GLuint> colorBuffers_;
+  GLuint depthBuffer_ = 0;
+  int width_ = 0, height_ = 0;
+};
+
+}  // namespace limn::render::raster

@@ -1,0 +1,35 @@
+// ShaderProgram: a linked GLSL program (vertex + fragment) owned by one context. Compile and
+// link errors become std::runtime_error with the driver's log. Uniforms are set through the
+// direct-state-access calls, so the program need not be bound to be configured.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "render/raster/gl_api.h"
+
+namespace limn::render::raster {
+
+class ShaderProgram {
+ public:
+  ShaderProgram(const std::string& name, const std::string& vertexSource,
+                const std::string& fragmentSource);
+  ~ShaderProgram();
+  ShaderProgram(const ShaderProgram&) = delete;
+  ShaderProgram& operator=(const ShaderProgram&) = delete;
+
+  void use() const { glUseProgram(program_); }
+
+  // Setting a uniform the compiler optimised away is not an error (location -1 is ignored).
+  void setMatrix(const char* uniform, const std::array<float, 16>& columnMajor) const;
+  void setVec3(const char* uniform, float x, float y, float z) const;
+  void setVec4(const char* uniform, const float rgba[4]) const;
+  void setBool(const char* uniform, bool value) const;
+
+ private:
+  GLint location(const char* uniform) const { return glGetUniformLocation(program_, uniform); }
+
+  GLuint program_ = 0;
+};
+
+}  // namespace limn::render::raster

@@ -1,0 +1,657 @@
+// Tests of render/raster: the headless EGL/OpenGL rasteriser against what the camera and the
+// shading model say each pixel must hold (coverage from Camera::project, linear depth, normals,
+// shading::shade colours, supersampled coverage, tiles, wireframe, threads).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/core/shading.h"
+#include "render/raster/rasterizer.h"
+#include "render/raster/shaders.h"
+#include "render/raster/tiling.h"
+
+namespace limn::render::raster {
+namespace {
+
+using tessellate::TriangleMesh;
+
+// A planar quad a, b, c, d (counter-clockwise seen from where `normal` points) as two
+// triangles, every vertex carrying that normal.
+TriangleMesh quad(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+  TriangleMesh mesh;
+  Vec3f n(normalize(cross(b - a, d - a)));
+  for (const Vec3& p : {a, b, c, d}) {
+    mesh.positions.emplace_back(p);
+    mesh.normals.push_back(n);
+  }
+  mesh.indices = {0, 1, 2, 0, 2, 3};
+  return mesh;
+}
+
+TriangleMesh append(TriangleMesh a, const TriangleMesh& b) {
+  const uint32_t base = static_cast<uint32_t>(a.positions.size());
+  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  a.normals.insert(a.normals.end(), b.normals.begin(), b.normals.end());
+  for (uint32_t i : b.indices) a.indices.push_back(base + i);
+  return a;
+}
+
+// The quad of most tests: off-centre and tilted, so flips and offsets of rows, columns or
+// depth would show. Its corners, counter-clockwise seen from +Z.
+const Vec3 kQuad[4] = {{-1.3, -0.4, 0.3}, {0.7, -0.4, -0.2}, {0.7, 1.1, -0.2}, {-1.3, 1.1, 0.3}};
+TriangleMesh tiltedQuad() { return quad(kQuad[0], kQuad[1], kQuad[2], kQuad[3]); }
+Vec3 tiltedQuadNormal() { return normalize(cross(kQuad[1] - kQuad[0], kQuad[3] - kQuad[0])); }
+
+Camera perspectiveCamera(int width = 64, int height = 48) {
+  return Camera({0.4, 0.3, 5}, {0, 0.2, 0}, {0, 1, 0}, 35.0, Projection::Perspective, 2.0, width,
+                height, 1.0, 10.0);
+}
+
+Camera orthographicCamera(int width = 64, int height = 48) {
+  return Camera({0.4, 0.3, 5}, {0, 0.2, 0}, {0, 1, 0}, 35.0, Projection::Orthographic, 3.0,
+                width, height, 1.0, 10.0);
+}
+
+// Where the pixel centre (x, y) of `camera` meets the plane of the tilted quad, if it does.
+bool hitQuadPlane(const Camera& camera, double x, double y, Vec3& hit) {
+  Ray ray = camera.rayThrough(x, y);
+  Vec3 n = tiltedQuadNormal();
+  double denom = dot(ray.direction, n);
+  if (std::fabs(denom) < 1e-12) return false;
+  double t = dot(kQuad[0] - ray.origin, n) / denom;
+  hit = ray.origin + ray.direction * t;
+  return t > 0;
+}
+
+// Signed distance in pixels from (x, y) to the inside of a convex polygon projected by
+// `camera` (positive inside): the coverage the rasteriser must produce, from Camera::project.
+double insideDistance(const Camera& camera, const std::vector<Vec3>& polygon, double x, double y) {
+  std::vector<Vec3> px;
+  for (const Vec3& p : polygon) px.push_back(camera.project(p));
+  // Orientation of the projected polygon (pixel y points down).
+  double area = 0;
+  for (size_t i = 0; i < px.size(); ++i) {
+    const Vec3& a = px[i];
+    const Vec3& b = px[(i + 1) % px.size()];
+    area += a.x * b.y - b.x * a.y;
+  }
+  double sign = area > 0 ? 1.0 : -1.0;
+  double distance = 1e300;
+  for (size_t i = 0; i < px.size(); ++i) {
+    const Vec3& a = px[i];
+    const Vec3& b = px[(i + 1) % px.size()];
+    double ex = b.x - a.x, ey = b.y - a.y;
+    double cross2 = ex * (y - a.y) - ey * (x - a.x);
+    distance = std::min(distance, sign * cross2 / std::hypot(ex, ey));
+  }
+  return distance;
+}
+
+std::vector<Vec3> quadCorners() { return {kQuad[0], kQuad[1], kQuad[2], kQuad[3]}; }
+
+// Distance from point (x, y) to the segment a-b, in pixels.
+double segmentDistance(Vec3 a, Vec3 b, double x, double y) {
+  double ex = b.x - a.x, ey = b.y - a.y;
+  double t = std::clamp(((x - a.x) * ex + (y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
+  return std::hypot(x - (a.x + t * ex), y - (a.y + t * ey));
+}
+
+PassSelection allPasses(int supersample = 0) {
+  PassSelection passes;
+  passes.color = passes.mask = passes.depth = passes.normal = true;
+  passes.supersample = supersample;
+  return passes;
+}
+
+class RasterTest : public ::testing::Test {
+ protected:
+  // One context for the whole suite: creating one costs tens of milliseconds.
+  static void SetUpTestSuite() { rasterizer_ = new Rasterizer(); }
+  static void TearDownTestSuite() {
+    delete rasterizer_;
+    rasterizer_ = nullptr;
+  }
+  static Rasterizer& rasterizer() { return *rasterizer_; }
+
+  // Checks mask, depth, normal and colour of the tilted quad against the camera, pixel by
+  // pixel, skipping pixel centres within 1e-3 px of its outline.
+  static void expectTiltedQuad(const ImageSet& images, const Camera& camera) {
+    const Image* mask = images.find(pass::kMask);
+    const Image* depth = images.find(pass::kDepth);
+    const Image* normal = images.find(pass::kNormal);
+    const Image* color = images.find(pass::kColor);
+    ASSERT_TRUE(mask && depth && normal && color);
+    ASSERT_EQ(mask->width, camera.width());
+    ASSERT_EQ(mask->height, camera.height());
+    ASSERT_EQ(depth->channels, 1);
+    ASSERT_EQ(normal->channels, 3);
+    ASSERT_EQ(color->channels, 4);
+    const Vec3 n = tiltedQuadNormal();
+    int covered = 0, checked = 0;
+    for (int y = 0; y < camera.height(); ++y) {
+      for (int x = 0; x < camera.width(); ++x) {
+        double inside = insideDistance(camera, quadCorners(), x + 0.5, y + 0.5);
+        if (std::fabs(inside) < 1e-3) continue;
+        ++checked;
+        const bool expected = inside > 0;
+        ASSERT_EQ(mask->at(x, y), expected ? 1.0f : 0.0f) << "pixel " << x << ", " << y;
+        if (!expected) {
+          EXPECT_EQ(depth->at(x, y), 0.0f);
+          for (int k = 0; k < 3; ++k) EXPECT_EQ(normal->at(x, y, k), 0.0f);
+          for (int k = 0; k < 3; ++k) {
+            EXPECT_FLOAT_EQ(color->at(x, y, k), shading::kBackground[k]);
+          }
+          EXPECT_EQ(color->at(x, y, 3), 0.0f);
+          continue;
+        }
+        ++covered;
+        Vec3 hit;
+        ASSERT_TRUE(hitQuadPlane(camera, x + 0.5, y + 0.5, hit));
+        double expectedDepth = camera.depthOf(hit);
+        EXPECT_NEAR(depth->at(x, y), expectedDepth, 1e-4 * expectedDepth) << x << ", " << y;
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(normal->at(x, y, k), n[k], 1e-3) << x << "," << y;
+        Vec3 toEye = camera.projection() == Projection::Perspective ? normalize(camera.eye() - hit)
+                                                                    : -camera.forward();
+        float rgb[3];
+        shading::shade(n, toEye, rgb);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(color->at(x, y, k), rgb[k], 1.0 / 255.0);
+        EXPECT_EQ(color->at(x, y, 3), 1.0f);
+      }
+    }
+    EXPECT_GT(covered, camera.width() * camera.height() / 8);  // the quad is really in view
+    EXPECT_LT(covered, checked);                               // and so is background
+  }
+
+  static Rasterizer* rasterizer_;
+};
+
+Rasterizer* RasterTest::rasterizer_ = nullptr;
+
+TEST(RasterTiling, TilesCoverTheFrameOnce) {
+  std::vector<Tile> tiles = makeTiles(10, 7, 4);
+  ASSERT_EQ(tiles.size(), 6u);
+  std::vector<int> hits(70, 0);
+  for (const Tile& t : tiles)
+    for (int y = t.y; y < t.y + t.height; ++y)
+      for (int x = t.x; x < t.x + t.width; ++x) ++hits[y * 10 + x];
+  for (int h : hits) EXPECT_EQ(h, 1);
+}
+
+TEST(RasterTiling, TileTransformMapsFramePixelsToTilePixels) {
+  // A 100 x 60 frame; the tile holds columns 40..69 and rows 10..29 (top-down).
+  const Tile tile{40, 10, 30, 20};
+  Mat4 m = tileClipTransform(100, 60, tile);
+  auto toTile = [&](double frameX, double frameYDown) {
+    double ndcX = 2.0 * frameX / 100 - 1, ndcY = 1.0 - 2.0 * frameYDown / 60;
+    double clipX = m[0] * ndcX + m[12], clipY = m[5] * ndcY + m[13];
+    // GL window coordinates of the tile (y up), then top-down rows of the tile.
+    return std::pair<double, double>{(clipX + 1) * 0.5 * 30, 20 - (clipY + 1) * 0.5 * 20};
+  };
+  auto [x0, y0] = toTile(40.5, 10.5);
+  EXPECT_NEAR(x0, 0.5, 1e-5);
+  EXPECT_NEAR(y0, 0.5, 1e-5);
+  auto [x1, y1] = toTile(69.5, 29.5);
+  EXPECT_NEAR(x1, 29.5, 1e-5);
+  EXPECT_NEAR(y1, 19.5, 1e-5);
+  // Reversed depth: near (z = -1) -> 1, far (z = 1) -> 0.
+  EXPECT_FLOAT_EQ(m[10] * -1.0f + m[14], 1.0f);
+  EXPECT_FLOAT_EQ(m[10] * 1.0f + m[14], 0.0f);
+}
+
+TEST(RasterShaders, ConstantsComeFromShadingHeader) {
+  EXPECT_EQ(glslFloat(40.0f), "40.0");
+  EXPECT_EQ(std::stof(glslFloat(shading::kFrontAlbedo[1])), shading::kFrontAlbedo[1]);
+  std::string fragment = surfaceFragmentShader();
+  EXPECT_NE(fragment.find("const float kShininess = " + glslFloat(shading::kShininess)),
+            std::string::npos);
+  EXPECT_NE(fragment.find(glslFloat(shading::kBackAlbedo[2])), std::string::npos);
+}
+
+TEST_F(RasterTest, ReportsItsDevice) {
+  const DeviceInfo& device = rasterizer().device();
+  EXPECT_FALSE(device.renderer.empty());
+  EXPECT_FALSE(device.vendor.empty());
+  EXPECT_NE(device.version.find("4."), std::string::npos) << device.version;
+  EXPECT_TRUE(device.eglPlatform == "device" || device.eglPlatform == "surfaceless");
+  std::printf("renderer: %s | vendor: %s | version: %s | EGL platform: %s\n",
+              device.renderer.c_str(), device.vendor.c_str(), device.version.c_str(),
+              device.eglPlatform.c_str());
+}
+
+TEST_F(RasterTest, PerspectiveQuadFlatShading) {
+  Camera camera = perspectiveCamera();
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, allPasses(), Shading::Flat);
+  expectTiltedQuad(images, camera);
+}
+
+TEST_F(RasterTest, PerspectiveQuadSmoothShading) {
+  Camera camera = perspectiveCamera(80, 50);
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, allPasses(), Shading::Smooth);
+  expectTiltedQuad(images, camera);
+}
+
+TEST_F(RasterTest, OrthographicQuad) {
+  Camera camera = orthographicCamera();
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, allPasses(), Shading::Flat);
+  expectTiltedQuad(images, camera);
+}
+
+TEST_F(RasterTest, OnlyTheSelectedPassesAreReturned) {
+  PassSelection passes;
+  passes.depth = true;
+  ImageSet images = rasterizer().render(tiltedQuad(), perspectiveCamera(), passes, Shading::Flat);
+  EXPECT_EQ(images.passes.size(), 1u);
+  EXPECT_NE(images.find(pass::kDepth), nullptr);
+  EXPECT_TRUE(images.supersampledMask.empty());
+  EXPECT_EQ(images.supersample, 1);
+}
+
+TEST_F(RasterTest, WorldPointLandsOnThePixelCameraProjectNames) {
+  Camera camera = perspectiveCamera(64, 48);
+  const int pixels[][2] = {{5, 7}, {60, 3}, {31, 40}, {0, 47}, {63, 0}};
+  for (auto [i, j] : pixels) {
+    // A point at depth 4.3 on the ray through the centre of pixel (i, j), and a square of half
+    // size 0.3 px around it facing the camera: only that pixel's centre can be covered.
+    Ray ray = camera.rayThrough(i + 0.5, j + 0.5);
+    Vec3 p = ray.origin + ray.direction * (4.3 / dot(ray.direction, camera.forward()));
+    Vec3 projected = camera.project(p);
+    ASSERT_NEAR(projected.x, i + 0.5, 1e-9);
+    ASSERT_NEAR(projected.y, j + 0.5, 1e-9);
+    double h = 0.3 / camera.pixelsPerUnit(camera.depthOf(p));
+    Vec3 r = camera.right() * h, u = camera.trueUp() * h;
+    TriangleMesh mesh = quad(p - r - u, p + r - u, p + r + u, p - r + u);
+    PassSelection passes;
+    passes.mask = true;
+    Image mask = rasterizer().render(mesh, camera, passes, Shading::Flat).passes[pass::kMask];
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 64; ++x)
+        ASSERT_EQ(mask.at(x, y), (x == i && y == j) ? 1.0f : 0.0f) << i << "," << j;
+  }
+}
+
+TEST_F(RasterTest, BackFacesKeepTheirWindingNormalAndGetTheBackAlbedo) {
+  // The same quad wound clockwise as seen from the camera.
+  TriangleMesh mesh = quad(kQuad[0], kQuad[3], kQuad[2], kQuad[1]);
+  Camera camera = perspectiveCamera();
+  ImageSet images = rasterizer().render(mesh, camera, allPasses(), Shading::Flat);
+  const Vec3 n = -tiltedQuadNormal();
+  int checked = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      if (insideDistance(camera, quadCorners(), x + 0.5, y + 0.5) < 0.01) continue;
+      Vec3 hit;
+      ASSERT_TRUE(hitQuadPlane(camera, x + 0.5, y + 0.5, hit));
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(images.passes[pass::kNormal].at(x, y, k), n[k], 1e-3);
+      float rgb[3];
+      shading::shade(n, normalize(camera.eye() - hit), rgb);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(images.passes[pass::kColor].at(x, y, k), rgb[k], 1e-3);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+  // The back albedo is bluish: blue above red.
+  float rgb[3];
+  shading::shade(n, -camera.forward(), rgb);
+  EXPECT_GT(rgb[2], rgb[0]);
+}
+
+TEST_F(RasterTest, SmoothShadingUsesTheInterpolatedVertexNormal) {
+  TriangleMesh mesh = tiltedQuad();
+  // Vertex normals that differ from the face normal and from each other (not unit length:
+  // the shader normalises after interpolation).
+  mesh.normals = {Vec3f(0, 0, 2), Vec3f(0, 0, 2), Vec3f(0.6f, 0, 0.8f), Vec3f(0.6f, 0, 0.8f)};
+  mesh.indices = {0, 1, 2, 0, 2, 3};
+  Camera camera = perspectiveCamera();
+  ImageSet images = rasterizer().render(mesh, camera, allPasses(), Shading::Smooth);
+  // From the bottom edge (+Z) to the top edge (0.6, 0, 0.8) the normal turns about Y: every
+  // pixel's normal is a unit vector with y = 0, and both ends of the turn occur.
+  const Image& normal = images.passes[pass::kNormal];
+  double minX = 1, maxX = -1;
+  int covered = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      if (images.passes[pass::kMask].at(x, y) == 0.0f) continue;
+      ++covered;
+      Vec3 n{normal.at(x, y, 0), normal.at(x, y, 1), normal.at(x, y, 2)};
+      EXPECT_NEAR(length(n), 1.0, 1e-5);
+      EXPECT_NEAR(n.y, 0.0, 1e-6);
+      minX = std::min(minX, n.x);
+      maxX = std::max(maxX, n.x);
+      float rgb[3];
+      Vec3 hit;
+      ASSERT_TRUE(hitQuadPlane(camera, x + 0.5, y + 0.5, hit));
+      shading::shade(n, normalize(camera.eye() - hit), rgb);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(images.passes[pass::kColor].at(x, y, k), rgb[k], 1e-4);
+      }
+    }
+  }
+  EXPECT_GT(covered, 100);
+  EXPECT_LT(minX, 0.05);
+  EXPECT_GT(maxX, 0.5);
+}
+
+TEST_F(RasterTest, SupersampledMaskMatchesCameraAndOutputMask) {
+  Camera camera = perspectiveCamera(64, 48);
+  const int S = 4;
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, allPasses(S), Shading::Flat);
+  ASSERT_EQ(images.supersample, S);
+  const Image& big = images.supersampledMask;
+  ASSERT_EQ(big.width, 64 * S);
+  ASSERT_EQ(big.height, 48 * S);
+  ASSERT_EQ(big.channels, 1);
+  // Exact against the supersampled camera.
+  Camera bigCamera = camera.scaled(S);
+  for (int y = 0; y < big.height; ++y) {
+    for (int x = 0; x < big.width; ++x) {
+      double inside = insideDistance(bigCamera, quadCorners(), x + 0.5, y + 0.5);
+      if (std::fabs(inside) < 1e-3) continue;
+      ASSERT_EQ(big.at(x, y), inside > 0 ? 1.0f : 0.0f) << x << ", " << y;
+    }
+  }
+  // Block majority agrees with the output mask except where a block is split evenly or at
+  // the quad's corners.
+  const Image& mask = images.passes[pass::kMask];
+  int disagree = 0;
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      int count = 0;
+      for (int v = 0; v < S; ++v)
+        for (int u = 0; u < S; ++u) count += big.at(x * S + u, y * S + v) > 0.5f;
+      if (count == S * S / 2) continue;
+      if ((count > S * S / 2) != (mask.at(x, y) > 0.5f)) ++disagree;
+    }
+  }
+  EXPECT_LE(disagree, 4);
+}
+
+TEST_F(RasterTest, LargeFramesAndSupersampledMasksAreTiled) {
+  // 2100 px wide: two frame tiles (2048 cap); S = 8 makes 16800 x 400: five coverage tiles
+  // (4096 cap). The view is shifted so that the quad straddles the seams at x = 2048 (frame)
+  // and x = 16384 (coverage).
+  Camera camera(Vec3{0.4 - 13.75, 0.3, 5}, Vec3{-13.75, 0.2, 0}, Vec3{0, 1, 0}, 10.0, Projection::Perspective,
+                2.0, 2100, 50, 1.0, 10.0);
+  PassSelection passes;
+  passes.mask = passes.depth = true;
+  passes.supersample = 8;
+  TriangleMesh mesh = tiltedQuad();
+  ImageSet images = rasterizer().render(mesh, camera, passes, Shading::Flat);
+  const Image& mask = images.passes[pass::kMask];
+  const Image& depth = images.passes[pass::kDepth];
+  int covered = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      double inside = insideDistance(camera, quadCorners(), x + 0.5, y + 0.5);
+      if (std::fabs(inside) < 1e-3) continue;
+      ASSERT_EQ(mask.at(x, y), inside > 0 ? 1.0f : 0.0f) << x << ", " << y;
+      if (inside > 0) {
+        ++covered;
+        Vec3 hit;
+        ASSERT_TRUE(hitQuadPlane(camera, x + 0.5, y + 0.5, hit));
+        ASSERT_NEAR(depth.at(x, y), camera.depthOf(hit), 1e-4 * camera.depthOf(hit));
+      }
+    }
+  }
+  EXPECT_GT(covered, 1000);
+  EXPECT_EQ(mask.at(2047, 25), 1.0f);
+  EXPECT_EQ(mask.at(2048, 25), 1.0f);
+  Camera bigCamera = camera.scaled(8);
+  const Image& big = images.supersampledMask;
+  ASSERT_EQ(big.width, 16800);
+  int bigCovered = 0;
+  for (int y = 0; y < big.height; ++y) {
+    for (int x = 0; x < big.width; ++x) {
+      double inside = insideDistance(bigCamera, quadCorners(), x + 0.5, y + 0.5);
+      if (std::fabs(inside) < 1e-2) continue;
+      ASSERT_EQ(big.at(x, y), inside > 0 ? 1.0f : 0.0f) << x << ", " << y;
+      bigCovered += inside > 0;
+    }
+  }
+  EXPECT_GT(bigCovered, 64 * 1000);
+  EXPECT_EQ(big.at(16383, 200), 1.0f);
+  EXPECT_EQ(big.at(16384, 200), 1.0f);
+}
+
+TEST_F(RasterTest, WireframeDiffersFromColorOnlyAlongEdges) {
+  Camera camera = perspectiveCamera(96, 72);
+  PassSelection passes;
+  passes.color = passes.wireframe = true;
+  TriangleMesh mesh = tiltedQuad();
+  ImageSet images = rasterizer().render(mesh, camera, passes, Shading::Flat);
+  const Image& color = images.passes[pass::kColor];
+  const Image& wire = images.passes[pass::kWireframe];
+  std::vector<Vec3> px;
+  for (const Vec3& p : quadCorners()) px.push_back(camera.project(p));
+  int drawn = 0, onDiagonal = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      bool same = true;
+      for (int k = 0; k < 4; ++k) same = same && wire.at(x, y, k) == color.at(x, y, k);
+      if (same) continue;
+      ++drawn;
+      double cx = x + 0.5, cy = y + 0.5;
+      double d = std::min({segmentDistance(px[0], px[1], cx, cy),
+                           segmentDistance(px[1], px[2], cx, cy),
+                           segmentDistance(px[2], px[3], cx, cy),
+                           segmentDistance(px[3], px[0], cx, cy)});
+      double diagonal = segmentDistance(px[0], px[2], cx, cy);
+      ASSERT_LE(std::min(d, diagonal), 1.0) << "pixel " << x << ", " << y << " is off the edges";
+      onDiagonal += diagonal < d;
+      for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(wire.at(x, y, k), shading::kWireColor[k]);
+      EXPECT_EQ(wire.at(x, y, 3), 1.0f);
+    }
+  }
+  EXPECT_GT(drawn, 150);      // the outline is roughly 2 * (60 + 45) px long
+  EXPECT_GT(onDiagonal, 30);  // triangle edges include the diagonal
+
+  // With explicit lines (the quad's outline), the diagonal is not drawn.
+  mesh.lines = {0, 1, 1, 2, 2, 3, 3, 0};
+  images = rasterizer().render(mesh, camera, passes, Shading::Flat);
+  onDiagonal = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      if (images.passes[pass::kWireframe].at(x, y, 0) == images.passes[pass::kColor].at(x, y, 0))
+        continue;
+      double cx = x + 0.5, cy = y + 0.5;
+      double d = std::min({segmentDistance(px[0], px[1], cx, cy),
+                           segmentDistance(px[1], px[2], cx, cy),
+                           segmentDistance(px[2], px[3], cx, cy),
+                           segmentDistance(px[3], px[0], cx, cy)});
+      EXPECT_LE(d, 1.0) << x << ", " << y;
+    }
+  }
+}
+
+TEST_F(RasterTest, HiddenEdgesDoNotShowInTheWireframe) {
+  Camera camera = perspectiveCamera(96, 72);
+  // A big quad in front (z = 1) and a small one behind it (z = -1), fully hidden.
+  TriangleMesh front = quad({-3, -3, 1}, {3, -3, 1}, {3, 3, 1}, {-3, 3, 1});
+  TriangleMesh back = quad({-0.5, -0.5, -1}, {0.5, -0.5, -1}, {0.5, 0.5, -1}, {-0.5, 0.5, -1});
+  front.lines = {0, 1, 1, 2, 2, 3, 3, 0};  // the front quad's outline is outside the view
+  TriangleMesh both = append(front, back);
+  both.lines = front.lines;
+  // Lines of the back quad, by index after appending.
+  for (uint32_t i : {4u, 5u, 5u, 6u, 6u, 7u, 7u, 4u}) both.lines.push_back(i);
+  PassSelection passes;
+  passes.color = passes.wireframe = true;
+  ImageSet images = rasterizer().render(both, camera, passes, Shading::Flat);
+  EXPECT_EQ(images.passes[pass::kWireframe].pixels, images.passes[pass::kColor].pixels);
+
+  // Without the front quad the same edges do show: the test above can fail.
+  back.lines = {0, 1, 1, 2, 2, 3, 3, 0};
+  images = rasterizer().render(back, camera, passes, Shading::Flat);
+  EXPECT_NE(images.passes[pass::kWireframe].pixels, images.passes[pass::kColor].pixels);
+}
+
+TEST_F(RasterTest, NearerSurfaceWinsRegardlessOfDrawOrder) {
+  Camera camera = perspectiveCamera();
+  TriangleMesh nearQuad = quad({-0.5, -0.5, 1.5}, {0.5, -0.5, 1.5}, {0.5, 0.5, 1.5}, {-0.5, 0.5, 1.5});
+  TriangleMesh farQuad = quad({-2, -2, -1}, {2, -2, -1}, {2, 2, -1}, {-2, 2, -1});
+  PassSelection passes;
+  passes.depth = true;
+  for (const TriangleMesh& mesh : {append(nearQuad, farQuad), append(farQuad, nearQuad)}) {
+    Image depth = rasterizer().render(mesh, camera, passes, Shading::Flat).passes[pass::kDepth];
+    Vec3 centre = camera.project({0, 0, 1.5});
+    int cx = static_cast<int>(centre.x), cy = static_cast<int>(centre.y);
+    Vec3 hit;
+    Ray ray = camera.rayThrough(cx + 0.5, cy + 0.5);
+    hit = ray.origin + ray.direction * ((1.5 - ray.origin.z) / ray.direction.z);
+    EXPECT_NEAR(depth.at(cx, cy), camera.depthOf(hit), 1e-4);
+  }
+}
+
+TEST_F(RasterTest, EmptyMeshGivesBackground) {
+  ImageSet images =
+      rasterizer().render(TriangleMesh{}, perspectiveCamera(), allPasses(2), Shading::Smooth);
+  for (float v : images.passes[pass::kMask].pixels) ASSERT_EQ(v, 0.0f);
+  for (float v : images.supersampledMask.pixels) ASSERT_EQ(v, 0.0f);
+  const Image& color = images.passes[pass::kColor];
+  EXPECT_FLOAT_EQ(color.at(3, 4, 1), shading::kBackground[1]);
+  EXPECT_EQ(color.at(3, 4, 3), 0.0f);
+}
+
+TEST_F(RasterTest, MeshWithoutNormalsIsShadedFlat) {
+  TriangleMesh mesh = tiltedQuad();
+  mesh.normals.clear();
+  Camera camera = perspectiveCamera();
+  ImageSet images = rasterizer().render(mesh, camera, allPasses(), Shading::Smooth);
+  expectTiltedQuad(images, camera);
+}
+
+TEST_F(RasterTest, RejectsBadMeshesAndCameras) {
+  TriangleMesh mesh = tiltedQuad();
+  mesh.indices.push_back(0);
+  EXPECT_THROW(rasterizer().render(mesh, perspectiveCamera(), allPasses(), Shading::Flat),
+               std::invalid_argument);
+  mesh = tiltedQuad();
+  mesh.indices[4] = 4;
+  EXPECT_THROW(rasterizer().render(mesh, perspectiveCamera(), allPasses(), Shading::Flat),
+               std::invalid_argument);
+  mesh = tiltedQuad();
+  mesh.normals.pop_back();
+  EXPECT_THROW(rasterizer().render(mesh, perspectiveCamera(), allPasses(), Shading::Flat),
+               std::invalid_argument);
+  EXPECT_THROW(rasterizer().render(tiltedQuad(), perspectiveCamera(0, 10), allPasses(),
+                                   Shading::Flat),
+               std::invalid_argument);
+  // Still usable afterwards.
+  Camera camera = perspectiveCamera();
+  expectTiltedQuad(rasterizer().render(tiltedQuad(), camera, allPasses(), Shading::Flat), camera);
+}
+
+// A UV sphere of radius r at the origin with smooth normals: 2 * rings * segments triangles.
+TriangleMesh sphere(double r, int rings, int segments) {
+  TriangleMesh mesh;
+  for (int i = 0; i <= rings; ++i) {
+    double theta = std::numbers::pi * i / rings;
+    for (int j = 0; j <= segments; ++j) {
+      double phi = 2 * std::numbers::pi * j / segments;
+      Vec3 n{std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi)};
+      mesh.positions.emplace_back(n * r);
+      mesh.normals.emplace_back(n);
+    }
+  }
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      uint32_t a = i * (segments + 1) + j, b = a + segments + 1;
+      // Counter-clockwise seen from outside.
+      for (uint32_t k : {a, a + 1, b, a + 1, b + 1, b}) mesh.indices.push_back(k);
+    }
+  }
+  return mesh;
+}
+
+TEST_F(RasterTest, SphereOfAHundredThousandTriangles) {
+  TriangleMesh mesh = sphere(1.0, 200, 250);  // 100,000 triangles
+  Camera camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 2.0, 1024, 1024,
+                2.0, 6.0);
+  rasterizer().render(mesh, camera, allPasses(4), Shading::Smooth);  // warm-up
+  auto start = std::chrono::steady_clock::now();
+  ImageSet images = rasterizer().render(mesh, camera, allPasses(4), Shading::Smooth);
+  double ms = std::chrono::duration<double, std::milli>(
+                  std::chrono::steady_clock::now() - start).count();
+  std::printf("1024^2 color+mask+depth+normal + S=4 mask, %zu triangles: %.1f ms\n",
+              mesh.triangleCount(), ms);
+  // Silhouette of a sphere seen from distance 4: a circle of angular radius asin(1/4).
+  double radiusPx = std::tan(std::asin(0.25)) * camera.pixelsPerUnit(1.0);
+  double area = 0;
+  for (float v : images.passes[pass::kMask].pixels) area += v;
+  EXPECT_NEAR(area, std::numbers::pi * radiusPx * radiusPx, 0.01 * area);
+  // The centre pixel looks straight at the sphere: depth 3, normal +Z, the brightest colour.
+  EXPECT_NEAR(images.passes[pass::kDepth].at(512, 512), 3.0, 1e-3);
+  EXPECT_NEAR(images.passes[pass::kNormal].at(512, 512, 2), 1.0, 1e-3);
+  double bigArea = 0;
+  for (float v : images.supersampledMask.pixels) bigArea += v;
+  EXPECT_NEAR(bigArea / 16, area, 0.002 * area);
+}
+
+TEST_F(RasterTest, MillionsOfTriangles) {
+  // A 1000 x 1000 grid of quads: 2 million triangles covering a square that fills the frame.
+  const int n = 1000;
+  TriangleMesh mesh;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) {
+      mesh.positions.emplace_back(-1.0f + 2.0f * x / n, -1.0f + 2.0f * y / n, 0.0f);
+      mesh.normals.emplace_back(0.0f, 0.0f, 1.0f);
+    }
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      uint32_t a = y * (n + 1) + x, b = a + n + 1;
+      for (uint32_t k : {a, a + 1, b + 1, a, b + 1, b}) mesh.indices.push_back(k);
+    }
+  Camera camera({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 30.0, Projection::Orthographic, 1.5, 256, 256,
+                1.0, 5.0);
+  PassSelection passes;
+  passes.mask = passes.depth = true;
+  ImageSet images = rasterizer().render(mesh, camera, passes, Shading::Smooth);
+  // The grid is larger than the view: every pixel covered at depth 3, no cracks.
+  for (float v : images.passes[pass::kMask].pixels) ASSERT_EQ(v, 1.0f);
+  for (float v : images.passes[pass::kDepth].pixels) ASSERT_NEAR(v, 3.0f, 1e-5f);
+}
+
+TEST(RasterThreads, TwoRasterizersOnTwoThreads) {
+  auto work = [](int width, std::string& error, int& coveredCount) {
+    try {
+      Rasterizer rasterizer;
+      Camera camera = perspectiveCamera(width, 48);
+      for (int round = 0; round < 20; ++round) {
+        PassSelection passes = allPasses(2);
+        ImageSet images = rasterizer.render(tiltedQuad(), camera, passes, Shading::Smooth);
+        int covered = 0;
+        for (int y = 0; y < 48; ++y)
+          for (int x = 0; x < width; ++x) {
+            double inside = insideDistance(camera, quadCorners(), x + 0.5, y + 0.5);
+            if (std::fabs(inside) < 1e-3) continue;
+            if (images.passes[pass::kMask].at(x, y) != (inside > 0 ? 1.0f : 0.0f)) {
+              throw std::runtime_error("wrong mask at round " + std::to_string(round));
+            }
+            covered += inside > 0;
+          }
+        coveredCount = covered;
+      }
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  };
+  std::string error1, error2;
+  int covered1 = 0, covered2 = 0;
+  std::thread t1(work, 64, std::ref(error1), std::ref(covered1));
+  std::thread t2(work, 80, std::ref(error2), std::ref(covered2));
+  t1.join();
+  t2.join();
+  EXPECT_EQ(error1, "");
+  EXPECT_EQ(error2, "");
+  EXPECT_GT(covered1, 300);
+  EXPECT_GT(covered2, 300);
+}
+
+}  // namespace
+}  // namespace limn::render::raster
