@@ -2,6 +2,8 @@
 // units, at points whose place on the limit surface is known.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -50,11 +52,10 @@ Partial reduceInChunks(size_t items, PerItem&& perItem) {
   return total;
 }
 
-// Barycentric weights of the seven samples of a triangle: corners, edge midpoints, centroid.
-constexpr double kSampleWeights[7][3] = {
-    {1, 0, 0}, {0, 1, 0}, {0, 0, 1},
-    {0.5, 0.5, 0}, {0, 0.5, 0.5}, {0.5, 0, 0.5},
-    {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+// A triangle is sampled at its three corners and at these barycentric blends of them: the edge
+// midpoints and the centroid.
+constexpr double kBlendWeights[4][3] = {
+    {0.5, 0.5, 0}, {0, 0.5, 0.5}, {0.5, 0, 0.5}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
 
 // Meshes whose vertices approximate the limit surface (coarse, uniform): each vertex against
 // its own limit position.
@@ -71,6 +72,12 @@ Partial measureVertices(const tessellate::TriangleMesh& mesh) {
 
 // Meshes that remember (face, u, v): seven points of every triangle against the limit surface
 // at the same barycentric combination of the corners' parameters.
+//
+// Surface evaluation is nearly all the cost, and a vertex is typically a corner of six
+// triangles, so each vertex is evaluated once, at the (face, u, v) of the first corner that
+// names it, and that distance is reused by every corner with the same face and (u, v).
+// Corners where the vertex has other parameters (across a face boundary) are evaluated on
+// their own. Each corner still counts as one sample, as the definition says.
 Partial measureTriangles(const tessellate::TriangleMesh& mesh,
                          const subdiv::LimitSurface& surface) {
   const size_t triangles = mesh.triangleCount();
@@ -79,6 +86,47 @@ Partial measureTriangles(const tessellate::TriangleMesh& mesh,
         "measureGeometry: the mesh has neither limit positions nor (face, u, v) for each "
         "triangle");
   }
+  constexpr uint32_t kUnused = std::numeric_limits<uint32_t>::max();
+  const size_t vertices = mesh.positions.size();
+  std::vector<uint32_t> firstCorner(vertices, kUnused);
+  for (size_t c = 0; c < 3 * triangles; ++c) {
+    const uint32_t v = mesh.indices[c];
+    if (v >= vertices) {
+      throw std::invalid_argument("measureGeometry: triangle " + std::to_string(c / 3) +
+                                  " names vertex " + std::to_string(v) + " of " +
+                                  std::to_string(vertices));
+    }
+    const int face = mesh.triangleFaces[c / 3];
+    if (face < 0 || face >= surface.faceCount()) {
+      throw std::invalid_argument("measureGeometry: triangle " + std::to_string(c / 3) +
+                                  " names face " + std::to_string(face) + " of " +
+                                  std::to_string(surface.faceCount()));
+    }
+    if (firstCorner[v] == kUnused) firstCorner[v] = static_cast<uint32_t>(c);
+  }
+  auto sameParameters = [&](size_t c, size_t d) {
+    return mesh.triangleFaces[c / 3] == mesh.triangleFaces[d / 3] &&
+           mesh.cornerUVs[c].x == mesh.cornerUVs[d].x &&
+           mesh.cornerUVs[c].y == mesh.cornerUVs[d].y;
+  };
+  auto cornerDistance = [&](size_t c) {
+    const Vec2f uv = mesh.cornerUVs[c];
+    return length(mesh.positions[mesh.indices[c]].toDouble() -
+                  surface.position(mesh.triangleFaces[c / 3], uv.x, uv.y));
+  };
+
+  // Vertex distances, at each vertex's first corner (holes have no surface: left unused).
+  std::vector<double> vertexDistance(vertices, 0.0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices, kChunk),
+                    [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t v = range.begin(); v < range.end(); ++v) {
+      const uint32_t c = firstCorner[v];
+      if (c != kUnused && surface.hasLimit(mesh.triangleFaces[c / 3])) {
+        vertexDistance[v] = cornerDistance(c);
+      }
+    }
+  });
+
   // Bfr parameterisations are the same for every call on a face; look them up once.
   std::vector<OpenSubdiv::Bfr::Parameterization> params(surface.faceCount());
   for (int f = 0; f < surface.faceCount(); ++f) {
@@ -86,31 +134,27 @@ Partial measureTriangles(const tessellate::TriangleMesh& mesh,
   }
   return reduceInChunks(triangles, [&](size_t t, Partial& p) {
     const int face = mesh.triangleFaces[t];
-    if (face < 0 || face >= surface.faceCount()) {
-      throw std::invalid_argument("measureGeometry: triangle " + std::to_string(t) +
-                                  " names face " + std::to_string(face) + " of " +
-                                  std::to_string(surface.faceCount()));
-    }
     if (!surface.hasLimit(face)) return;  // holes have no surface to be measured against
     Vec3 corner[3];
     Vec2f uv[3];
     for (int k = 0; k < 3; ++k) {
-      corner[k] = mesh.positions[mesh.indices[3 * t + k]].toDouble();
-      uv[k] = mesh.cornerUVs[3 * t + k];
+      const size_t c = 3 * t + k;
+      const uint32_t v = mesh.indices[c];
+      corner[k] = mesh.positions[v].toDouble();
+      uv[k] = mesh.cornerUVs[c];
+      p.add(sameParameters(c, firstCorner[v]) ? vertexDistance[v] : cornerDistance(c));
     }
     // Faces split into quad sub-faces (Catmull-Clark n-gons, n != 4) have a parameter space
     // made of separate tiles; between corners on different tiles a linear blend of (u, v)
     // lands in no sub-face at all, so such a triangle is measured at its corners only.
-    int samples = 7;
     const OpenSubdiv::Bfr::Parameterization& param = params[face];
     if (param.HasSubFaces()) {
       const float c0[2] = {uv[0].x, uv[0].y}, c1[2] = {uv[1].x, uv[1].y},
                   c2[2] = {uv[2].x, uv[2].y};
       const int s0 = param.GetSubFace(c0);
-      if (param.GetSubFace(c1) != s0 || param.GetSubFace(c2) != s0) samples = 3;
+      if (param.GetSubFace(c1) != s0 || param.GetSubFace(c2) != s0) return;
     }
-    for (int i = 0; i < samples; ++i) {
-      const double* w = kSampleWeights[i];
+    for (const auto& w : kBlendWeights) {
       const Vec3 onTriangle = corner[0] * w[0] + corner[1] * w[1] + corner[2] * w[2];
       const double u = w[0] * uv[0].x + w[1] * uv[1].x + w[2] * uv[2].x;
       const double v = w[0] * uv[0].y + w[1] * uv[1].y + w[2] * uv[2].y;

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "render/metrics/metrics.h"
+#include "render/subdiv/limit_surface.h"
+#include "tests/unit/test_meshes.h"
 
 namespace limn::render::metrics {
 namespace {
@@ -376,6 +378,207 @@ TEST(Normals, SmallAnglePrecision) {
   ImageSet a = rendering(1, 1), b = rendering(1, 1);
   b.passes[pass::kNormal].at(0, 0, 0) = static_cast<float>(std::tan(1e-4));
   EXPECT_NEAR(compareNormals(a, b).maxDeg, 1e-4 * 180.0 / M_PI, 1e-7);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry against a real OpenSubdiv limit surface
+
+// Builds a TriangleMesh triangle by triangle: each corner at the limit position of its (u, v)
+// on `face`, plus `offset`.
+struct TriangleMeshBuilder {
+  const subdiv::LimitSurface& surface;
+  tessellate::TriangleMesh mesh;
+  Vec3 offset{0, 0, 0};
+
+  void add(int face, Vec2 a, Vec2 b, Vec2 c) {
+    for (Vec2 uv : {a, b, c}) {
+      mesh.indices.push_back(static_cast<uint32_t>(mesh.positions.size()));
+      mesh.positions.push_back(Vec3f(surface.position(face, uv.x, uv.y) + offset));
+      mesh.cornerUVs.push_back({static_cast<float>(uv.x), static_cast<float>(uv.y)});
+    }
+    mesh.triangleFaces.push_back(face);
+  }
+  // An n x n grid of quads over [u0,u1] x [v0,v1], two triangles each.
+  void addGrid(int face, int n, double u0 = 0, double v0 = 0, double u1 = 1, double v1 = 1) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const double ua = u0 + (u1 - u0) * i / n, ub = u0 + (u1 - u0) * (i + 1) / n;
+        const double va = v0 + (v1 - v0) * j / n, vb = v0 + (v1 - v0) * (j + 1) / n;
+        add(face, {ua, va}, {ub, va}, {ub, vb});
+        add(face, {ua, va}, {ub, vb}, {ua, vb});
+      }
+    }
+  }
+};
+
+// Float positions put every vertex up to ~1e-7 (relative) off the surface.
+constexpr double kFloatNoise = 1e-6;
+
+TEST(Geometry, FlatFaceIsMeasuredExactlyAtInterpolatedParameters) {
+  // On a flat, uniform grid the Catmull-Clark limit of an interior face is the bilinear map of
+  // its corners, so triangles of limit points lie on the surface at the barycentric blend of
+  // their corners' (u, v): anything but ~0 means positions and parameters were blended apart.
+  const subdiv::LimitSurface surface(testing::grid(4, 0.0));
+  const int interiorFace = 5;
+  TriangleMeshBuilder builder{surface, {}};
+  builder.addGrid(interiorFace, 3);
+  builder.add(interiorFace, {0.1, 0.2}, {0.9, 0.3}, {0.4, 0.95});
+  const GeometryMetrics exact = measureGeometry(builder.mesh, surface);
+  EXPECT_LT(exact.maxDist, kFloatNoise);
+
+  // The same mesh lifted 0.01 off the plane: every sample is exactly that far.
+  TriangleMeshBuilder lifted{surface, {}, {0, 0, 0.01}};
+  lifted.addGrid(interiorFace, 3);
+  const GeometryMetrics m = measureGeometry(lifted.mesh, surface);
+  EXPECT_NEAR(m.maxDist, 0.01, kFloatNoise);
+  EXPECT_NEAR(m.meanDist, 0.01, kFloatNoise);
+  EXPECT_NEAR(m.relMaxDist, 0.01 / surface.bounds().diagonal(), kFloatNoise);
+}
+
+TEST(Geometry, ChordsOfACurvedFaceLeaveTheSurfaceAndShrinkWithRefinement) {
+  const subdiv::LimitSurface surface(testing::cube());
+  const int face = 0;
+  TriangleMeshBuilder coarse{surface, {}};
+  coarse.add(face, {0, 0}, {1, 0}, {1, 1});
+  coarse.add(face, {0, 0}, {1, 1}, {0, 1});
+  const GeometryMetrics one = measureGeometry(coarse.mesh, surface);
+  // The cube's limit surface bulges: two triangles spanning a face cut well inside it, but by
+  // less than the face is wide.
+  EXPECT_GT(one.maxDist, 0.01);
+  EXPECT_LT(one.maxDist, 0.2);
+  EXPECT_GT(one.meanDist, 0.0);
+  EXPECT_LT(one.meanDist, one.maxDist);
+  EXPECT_DOUBLE_EQ(one.relMaxDist, one.maxDist / surface.bounds().diagonal());
+
+  // The largest of the seven samples, worked out here independently.
+  double worst = 0;
+  const double weights[7][3] = {{1, 0, 0},     {0, 1, 0},     {0, 0, 1},          {.5, .5, 0},
+                                {0, .5, .5},   {.5, 0, .5},   {1. / 3, 1. / 3, 1. / 3}};
+  for (size_t t = 0; t < coarse.mesh.triangleCount(); ++t) {
+    for (const auto& w : weights) {
+      Vec3 p{0, 0, 0};
+      double u = 0, v = 0;
+      for (int k = 0; k < 3; ++k) {
+        p += coarse.mesh.positions[coarse.mesh.indices[3 * t + k]].toDouble() * w[k];
+        u += coarse.mesh.cornerUVs[3 * t + k].x * w[k];
+        v += coarse.mesh.cornerUVs[3 * t + k].y * w[k];
+      }
+      worst = std::max(worst, length(p - surface.position(face, u, v)));
+    }
+  }
+  EXPECT_NEAR(one.maxDist, worst, 1e-12);
+
+  // Chord error falls with the square of the edge length: 8x finer, ~64x closer.
+  TriangleMeshBuilder fine{surface, {}};
+  fine.addGrid(face, 8);
+  const GeometryMetrics eight = measureGeometry(fine.mesh, surface);
+  EXPECT_GT(eight.maxDist, 0.0);
+  EXPECT_LT(eight.maxDist, one.maxDist / 20);
+}
+
+// Indexed like a real tessellation: vertices shared by the triangles of a face.
+tessellate::TriangleMesh sharedGrid(const subdiv::LimitSurface& surface, int face, int n) {
+  tessellate::TriangleMesh mesh;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      mesh.positions.push_back(Vec3f(surface.position(face, double(i) / n, double(j) / n)));
+    }
+  }
+  auto uv = [&](int i, int j) { return Vec2f{float(i) / n, float(j) / n}; };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+      mesh.indices.insert(mesh.indices.end(), {a, b, c, a, c, d});
+      mesh.cornerUVs.insert(mesh.cornerUVs.end(), {uv(i, j), uv(i + 1, j), uv(i + 1, j + 1),
+                                                   uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)});
+      mesh.triangleFaces.insert(mesh.triangleFaces.end(), {face, face});
+    }
+  }
+  return mesh;
+}
+
+TEST(Geometry, SharedVerticesCountOncePerCorner) {
+  // The same triangles, once with vertices shared and once with every corner its own vertex,
+  // measure the same: a shared vertex still counts once per corner.
+  const subdiv::LimitSurface surface(testing::cube());
+  const tessellate::TriangleMesh shared = sharedGrid(surface, 2, 5);
+  TriangleMeshBuilder separate{surface, {}};
+  separate.addGrid(2, 5);
+  const GeometryMetrics a = measureGeometry(shared, surface);
+  const GeometryMetrics b = measureGeometry(separate.mesh, surface);
+  EXPECT_GT(a.maxDist, 0.0);
+  EXPECT_NEAR(a.maxDist, b.maxDist, 1e-12);
+  EXPECT_NEAR(a.meanDist, b.meanDist, 1e-12);
+
+  // A vertex shared with a triangle of another face, whose parameters there point elsewhere:
+  // that corner is measured at its own (face, u, v).
+  tessellate::TriangleMesh mesh = sharedGrid(surface, 0, 1);  // vertex 0 at face 0, (0, 0)
+  mesh.positions.push_back(Vec3f(surface.position(1, 1, 0)));
+  mesh.positions.push_back(Vec3f(surface.position(1, 1, 1)));
+  mesh.indices.insert(mesh.indices.end(), {0, 4, 5});
+  mesh.cornerUVs.insert(mesh.cornerUVs.end(), {{0.5f, 0.5f}, {1, 0}, {1, 1}});
+  mesh.triangleFaces.push_back(1);
+  const double misplaced = length(surface.position(0, 0, 0) - surface.position(1, 0.5, 0.5));
+  EXPECT_GE(measureGeometry(mesh, surface).maxDist, misplaced - kFloatNoise);
+}
+
+TEST(Geometry, VerticesAgainstTheirOwnLimitPositions) {
+  const subdiv::LimitSurface surface(testing::cube());
+  tessellate::TriangleMesh mesh;
+  for (const Vec3& p : surface.controlLimitPositions()) {
+    mesh.positions.push_back(Vec3f(p));
+    mesh.limitPositions.push_back(Vec3f(p));
+  }
+  mesh.indices = {0, 1, 3, 0, 3, 2};
+  EXPECT_EQ(measureGeometry(mesh, surface).maxDist, 0.0);
+
+  // Cage vertices measured against their limits: the cube's corners sit well outside.
+  tessellate::TriangleMesh cage = mesh;
+  for (size_t v = 0; v < cage.positions.size(); ++v) {
+    cage.positions[v] = Vec3f(surface.mesh().points[v]);
+  }
+  const double expected = length(surface.mesh().points[0] - surface.controlLimitPositions()[0]);
+  const GeometryMetrics m = measureGeometry(cage, surface);
+  EXPECT_NEAR(m.maxDist, expected, kFloatNoise);  // all eight corners are alike
+  EXPECT_NEAR(m.meanDist, expected, kFloatNoise);
+
+  // One vertex moved by 0.05: max 0.05, mean 0.05 / 8.
+  mesh.positions[4].y += 0.05f;
+  const GeometryMetrics one = measureGeometry(mesh, surface);
+  EXPECT_NEAR(one.maxDist, 0.05, kFloatNoise);
+  EXPECT_NEAR(one.meanDist, 0.05 / 8, kFloatNoise);
+}
+
+TEST(Geometry, TrianglesAcrossSubFacesAreMeasuredAtTheirCorners) {
+  // Catmull-Clark triangles are parameterised as three quad sub-faces on separate tiles of
+  // (u, v); a triangle from a corner of one tile to a corner of another has no meaningful
+  // midpoint parameters, so only its corners count.
+  const subdiv::LimitSurface surface(testing::octahedron());
+  const int face = 0;
+  ASSERT_TRUE(surface.parameterization(face).HasSubFaces());
+  TriangleMeshBuilder across{surface, {}};
+  across.add(face, surface.cornerUV(face, 0), surface.cornerUV(face, 1), surface.centerUV(face));
+  across.add(face, surface.cornerUV(face, 1), surface.cornerUV(face, 2), surface.centerUV(face));
+  EXPECT_LT(measureGeometry(across.mesh, surface).maxDist, kFloatNoise);
+
+  // Inside one sub-face (tile 0 spans [0, 0.5]^2: corner, edge midpoints, centre) the samples
+  // are all measured, and the curved surface leaves the chords.
+  TriangleMeshBuilder inside{surface, {}};
+  inside.add(face, {0, 0}, {0.5, 0}, {0.5, 0.5});
+  inside.add(face, {0, 0}, {0.5, 0.5}, {0, 0.5});
+  const GeometryMetrics m = measureGeometry(inside.mesh, surface);
+  EXPECT_GT(m.maxDist, 1e-4);
+  EXPECT_LT(m.maxDist, 0.2);
+}
+
+TEST(Geometry, MeshWithoutLimitInformationIsRejected) {
+  const subdiv::LimitSurface surface(testing::cube());
+  tessellate::TriangleMesh mesh;
+  mesh.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  mesh.indices = {0, 1, 2};
+  EXPECT_THROW(measureGeometry(mesh, surface), std::invalid_argument);
+  // An empty mesh measures nothing.
+  EXPECT_EQ(measureGeometry(tessellate::TriangleMesh{}, surface).maxDist, 0.0);
 }
 
 }  // namespace
