@@ -37,22 +37,36 @@ struct Metrics {
 };
 
 // Silhouette pixels of a mask: covered pixels with an uncovered 4-neighbour (outside the image
-// counts as uncovered). Both masks are at `supersample` times the output size.
+// counts as uncovered). Both masks are at `supersample` times the output size, one channel,
+// covered where the value is above 0.5. When only one mask shows anything, hausdorffPx and
+// meanPx are the image diagonal in output pixels; when neither does, both are 0 and iou is 1.
+// Throws std::invalid_argument for masks of different sizes, not one channel, or a size that is
+// not a multiple of `supersample`.
 SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask,
                                      int supersample);
-// Over pixels covered in either image's mask pass.
+// Coverage comes from each set's "mask" pass, else the colour's alpha (> 0.5), else depth > 0.
+// Missing or mismatched passes throw std::invalid_argument.
+//
+// RGB over pixels covered in either. psnr = 20 log10(1 / rmse), capped at 100 dB (identical
+// images would otherwise be infinite, which JSON cannot carry).
 ColorMetrics compareColor(const ImageSet& approx, const ImageSet& reference);
 // Over pixels covered in both; relative to `diagonal` (the mesh's bounding-box diagonal).
 DepthMetrics compareDepth(const ImageSet& approx, const ImageSet& reference, double diagonal);
+// Angle between the normalised normals where both are covered; pixels with a zero normal are
+// left out.
 NormalMetrics compareNormals(const ImageSet& approx, const ImageSet& reference);
 // Triangle vertices, edge midpoints and centroid against the limit surface at the same
-// (face, u, v); or, for meshes with limitPositions, every vertex against its own.
+// (face, u, v); or, for meshes with limitPositions, every vertex against its own. Triangles on
+// faces without a limit (holes) are skipped; triangles whose corners lie on different Bfr
+// sub-faces are measured at their corners only. A mesh with neither kind of information throws
+// std::invalid_argument.
 GeometryMetrics measureGeometry(const tessellate::TriangleMesh& mesh,
                                 const subdiv::LimitSurface& surface);
 
 // Exact squared Euclidean distance transform (Felzenszwalb-Huttenlocher): for each pixel the
 // squared distance to the nearest pixel where `isFeature` is true. Exposed for tests and the
-// normal-map dilation of later work.
+// normal-map dilation of later work. Pixels with no feature anywhere get +infinity. The image
+// may be at most 65535 pixels tall (std::invalid_argument otherwise).
 std::vector<double> squaredDistanceTransform(const std::vector<bool>& isFeature, int width,
                                              int height);
 
