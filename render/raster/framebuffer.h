@@ -29,6 +29,9 @@ class Framebuffer {
   // Reads attachment `attachment` as floats, `components` per pixel (GL_RED: 1, GL_RGBA: 4),
   // bottom row first as OpenGL stores it.
   void read(int attachment, GLenum format, std::vector<float>& out) const;
+  // Reads the red channel of an 8-bit attachment as bytes (4 times less to convert and copy
+  // than floats, which matters for the large supersampled coverage).
+  void readRedBytes(int attachment, std::vector<unsigned char>& out) const;
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -42,15 +42,15 @@ int largestFramebufferSide() {
   return std::min({renderbuffer, viewport[0], viewport[1], fbWidth, fbHeight});
 }
 
-// Copies a tile read back from OpenGL (bottom row first, `srcComponents` floats per pixel)
-// into its place in `dst` (top row first), through `convert(const float* src, float* dst)`.
-template <typename Convert>
-void placeTile(const std::vector<float>& src, int srcComponents, const Tile& tile, Image& dst,
+// Copies a tile read back from OpenGL (bottom row first, `srcComponents` values per pixel)
+// into its place in `dst` (top row first), through `convert(const T* src, float* dst)`.
+template <typename T, typename Convert>
+void placeTile(const std::vector<T>& src, int srcComponents, const Tile& tile, Image& dst,
                Convert convert) {
   for (int r = 0; r < tile.height; ++r) {
     const int dstRow = tile.y + tile.height - 1 - r;
     for (int i = 0; i < tile.width; ++i) {
-      const float* from = &src[(static_cast<size_t>(r) * tile.width + i) * srcComponents];
+      const T* from = &src[(static_cast<size_t>(r) * tile.width + i) * srcComponents];
       convert(from, &dst.at(tile.x + i, dstRow, 0));
     }
   }
@@ -74,6 +74,7 @@ struct Rasterizer::Impl {
   int frameTileSize = 0;
   int coverageTileSize = 0;
   std::vector<float> readback;
+  std::vector<unsigned char> readbackBytes;
 
   Impl();
   ~Impl();
@@ -216,8 +217,9 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample, Ima
                            multiply(tileClipTransform(width, height, tile), viewProjection));
     mesh.drawTriangles();
     checkGl("drawing the supersampled coverage");
-    coverage.read(0, GL_RED, readback);
-    placeTile(readback, 1, tile, covered, copyComponents<1>);
+    coverage.readRedBytes(0, readbackBytes);
+    placeTile(readbackBytes, 1, tile, covered,
+              [](const unsigned char* from, float* to) { *to = *from > 127 ? 1.0f : 0.0f; });
   }
   out.supersampledMask = std::move(covered);
   out.supersample = supersample;

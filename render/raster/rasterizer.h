@@ -5,6 +5,15 @@
 // llvmpipe otherwise) and makes it current on the calling thread. All rendering goes into
 // framebuffer objects; no window or display server is involved. Construct it on the thread
 // that will call render(), and destroy it there.
+//
+// What render() draws: every pass is point-sampled at pixel centres (no anti-aliasing), row 0
+// at the top. Geometry outside the camera's near/far planes is clipped. Colour follows
+// shading::shade() (back faces get the back albedo); the normal pass holds the shading normal
+// as computed (not flipped for back faces); depth is linear (Camera::depthOf), 0 where empty.
+// Frames larger than the GL limits, and supersampled masks, are drawn in tiles with the same
+// sample positions. Shaders and GL objects are made once and reused; a mesh without normals is
+// shaded flat. Bad input (indices out of range, normals not one per vertex, an empty image
+// size) throws std::invalid_argument; GL failures throw std::runtime_error naming the step.
 #pragma once
 
 #include <memory>
