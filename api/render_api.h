@@ -7,42 +7,29 @@
 #include <utility>
 #include <vector>
 
+#include "api/answer.h"
 #include "render/core/cancel.h"
 #include "render/image/encode.h"
 #include "render/pipeline/render_job.h"
 
 namespace limn::api {
 
-// An HTTP-shaped answer with no socket attached: what the server writes back.
-struct Answer {
-  int status = 200;
-  std::string contentType = "application/json";
-  std::string body;
-  std::vector<std::pair<std::string, std::string>> headers;  // extra, e.g. Retry-After
-};
-
-// A request the api layer refuses. `code` is one of DESIGN.md's error codes
-// (invalid_json, invalid_request, not_found, method_not_allowed, too_large, invalid_mesh, busy,
-// internal, unavailable, timeout); `detailJson` is a JSON object (may be "{}").
-struct ApiError {
-  int status;
-  std::string code;
-  std::string message;
-  std::string detailJson = "{}";
-};
-
-// {"error": {"code": ..., "message": ..., "detail": {...}}}
-Answer errorAnswer(const ApiError& error);
+// Answer, ApiError and errorAnswer() live in api/answer.h.
 
 struct RenderRequest {
   render::pipeline::RenderJob job;
   render::image::Format imageFormat = render::image::Format::Png;
+  // Notes for the client found while parsing (ignored OBJ tags, unknown fields); the answer's
+  // "warnings" lists them before the engine's own.
+  std::vector<std::string> warnings;
 };
 
 // Throws ApiError (400 invalid_json / invalid_request, 413 too_large, 422 invalid_mesh).
 RenderRequest parseRenderRequest(std::string_view json, const render::pipeline::JobLimits& limits);
 
-// The 200 answer's JSON: images (base64), reference.images, metrics, stats, timings, warnings.
+// The 200 answer's JSON: images (base64), reference.images, metrics, stats, timings, warnings,
+// camera. timings.totalMs = result.timings.parseMs + result.timings.totalMs (the engine's run)
+// + the time spent here encoding, which is also written as timings.encodeMs.
 std::string writeRenderResponse(const render::pipeline::RenderResult& result,
                                 const RenderRequest& request);
 

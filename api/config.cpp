@@ -1,0 +1,142 @@
+#include "api/config.h"
+
+#include <rapidjson/document.h>
+#include <rapidjson/error/en.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+namespace limn::api {
+
+namespace {
+
+using Value = rapidjson::Value;
+
+// Reads one object's keys into their targets, refusing unknown keys and wrong types.
+class ConfigReader {
+ public:
+  ConfigReader(const Value& object, std::string source, std::string prefix)
+      : object_(object), source_(std::move(source)), prefix_(std::move(prefix)) {
+    if (!object.IsObject()) fail(prefix_.empty() ? "the top level" : prefix_, "must be an object");
+    for (auto it = object.MemberBegin(); it != object.MemberEnd(); ++it) {
+      pending_.push_back(it->name.GetString());
+    }
+  }
+
+  void integer(const char* key, int& target, long min, long max = std::numeric_limits<int>::max()) {
+    if (const Value* v = take(key)) {
+      if (!v->IsInt64() || v->GetInt64() < min || v->GetInt64() > max) {
+        fail(path(key),
+             "must be an integer in " + std::to_string(min) + ".." + std::to_string(max));
+      }
+      target = static_cast<int>(v->GetInt64());
+    }
+  }
+
+  void size(const char* key, size_t& target, unsigned long long min) {
+    if (const Value* v = take(key)) {
+      if (!v->IsUint64() || v->GetUint64() < min) {
+        fail(path(key), "must be an integer >= " + std::to_string(min));
+      }
+      target = static_cast<size_t>(v->GetUint64());
+    }
+  }
+
+  void number(const char* key, double& target, double exclusiveMin) {
+    if (const Value* v = take(key)) {
+      if (!v->IsNumber() || !std::isfinite(v->GetDouble()) || !(v->GetDouble() > exclusiveMin)) {
+        std::ostringstream bound;
+        bound << exclusiveMin;
+        fail(path(key), "must be a number > " + bound.str());
+      }
+      target = v->GetDouble();
+    }
+  }
+
+  void string(const char* key, std::string& target) {
+    if (const Value* v = take(key)) {
+      if (!v->IsString() || v->GetStringLength() == 0)
+        fail(path(key), "must be a non-empty string");
+      target.assign(v->GetString(), v->GetStringLength());
+    }
+  }
+
+  const Value* object(const char* key) { return take(key); }
+
+  // Every key must have been taken by now.
+  void finish() const {
+    if (!pending_.empty()) fail(path(pending_.front().c_str()), "is not a known key");
+  }
+
+  std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+
+ private:
+  const Value* take(const char* key) {
+    for (auto it = pending_.begin(); it != pending_.end(); ++it) {
+      if (*it == key) {
+        pending_.erase(it);
+        return &object_[key];
+      }
+    }
+    return nullptr;
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+    throw ConfigError(source_ + ": \"" + key + "\" " + message);
+  }
+
+  const Value& object_;
+  std::string source_, prefix_;
+  std::vector<std::string> pending_;
+};
+
+void readLimits(const Value& object, const std::string& source,
+                render::pipeline::JobLimits& limits) {
+  ConfigReader r(object, source, "limits");
+  r.integer("maxVertices", limits.mesh.maxVertices, 1);
+  r.integer("maxFaces", limits.mesh.maxFaces, 1);
+  r.integer("maxFaceSize", limits.mesh.maxFaceSize, 3);
+  r.integer("maxImageSide", limits.maxImageSide, 1);
+  r.integer("maxSupersample", limits.maxSupersample, 1);
+  r.integer("maxLevel", limits.maxLevel, 0);
+  r.number("minDicingRate", limits.minDicingRate, 0.0);
+  r.size("maxTriangles", limits.maxTriangles, 1);
+  r.finish();
+}
+
+}  // namespace
+
+ServiceConfig parseConfig(std::string_view json, const std::string& source) {
+  rapidjson::Document document;
+  document.Parse<rapidjson::kParseIterativeFlag>(json.data(), json.size());
+  if (document.HasParseError()) {
+    throw ConfigError(source +
+                      ": not valid JSON: " + rapidjson::GetParseError_En(document.GetParseError()) +
+                      " (at offset " + std::to_string(document.GetErrorOffset()) + ")");
+  }
+  ServiceConfig config;
+  ConfigReader r(document, source, "");
+  r.string("host", config.host);
+  r.integer("port", config.port, 0, 65535);
+  r.integer("workers", config.workers, 0, 1024);
+  r.integer("queueDepth", config.queueDepth, 1);
+  r.integer("ioThreads", config.ioThreads, 1, 256);
+  r.size("maxBodyBytes", config.maxBodyBytes, 1);
+  r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);
+  if (const Value* limits = r.object("limits")) readLimits(*limits, source, config.limits);
+  r.finish();
+  return config;
+}
+
+ServiceConfig loadConfig(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw ConfigError(path + ": cannot be opened");
+  std::ostringstream text;
+  text << file.rdbuf();
+  return parseConfig(text.str(), path);
+}
+
+}  // namespace limn::api

@@ -1,0 +1,38 @@
+// ServiceConfig: the settings of one limn server process (listen address, worker pool, queue,
+// request limits), with built-in defaults so that no file is needed. loadConfig() reads a JSON
+// file whose keys mirror the member names (limits nested under "limits"); configs/default.json
+// holds the defaults. Unknown keys are an error, so a misspelt key is never silently ignored.
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "render/pipeline/render_job.h"
+
+namespace limn::api {
+
+struct ServiceConfig {
+  std::string host = "127.0.0.1";
+  int port = 8080;      // 0: any free port (tests)
+  int workers = 0;      // render workers; 0 = one per core
+  int queueDepth = 16;  // jobs waiting for a worker before answering 429
+  int ioThreads = 1;    // threads running the HTTP connections
+  size_t maxBodyBytes = 64u << 20;
+  int requestTimeoutMs = 120000;
+  render::pipeline::JobLimits limits;
+};
+
+// A configuration file that cannot be used; the message names the file and the key.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Keys left out keep their defaults. Throws ConfigError.
+ServiceConfig loadConfig(const std::string& path);
+// The same from JSON text; `source` names it in messages.
+ServiceConfig parseConfig(std::string_view json, const std::string& source = "config");
+
+}  // namespace limn::api

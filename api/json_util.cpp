@@ -1,0 +1,143 @@
+#include "api/json_util.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace limn::api::json {
+
+std::string describe(const Value& value) {
+  switch (value.GetType()) {
+    case rapidjson::kNullType:
+      return "null";
+    case rapidjson::kFalseType:
+    case rapidjson::kTrueType:
+      return "a boolean";
+    case rapidjson::kObjectType:
+      return "an object";
+    case rapidjson::kArrayType:
+      return "an array";
+    case rapidjson::kStringType:
+      return "a string";
+    case rapidjson::kNumberType:
+      return "a number";
+  }
+  return "a value";
+}
+
+std::string quote(std::string_view text, size_t maxBytes) {
+  bool cut = text.size() > maxBytes;
+  size_t end = cut ? maxBytes : text.size();
+  // Never end inside a multi-byte UTF-8 sequence: back up over continuation bytes.
+  while (cut && end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+  std::string out = "\"";
+  for (size_t i = 0; i < end; ++i) {
+    unsigned char c = static_cast<unsigned char>(text[i]);
+    out += (c < 0x20 || c == 0x7F) ? '?' : static_cast<char>(c);
+  }
+  out += cut ? "...\"" : "\"";
+  return out;
+}
+
+std::string formatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+std::string detailObject(std::initializer_list<std::pair<const char*, std::string>> members) {
+  rapidjson::StringBuffer buffer;
+  Writer writer(buffer);
+  writer.StartObject();
+  for (const auto& [key, value] : members) {
+    writeKey(writer, key);
+    writeString(writer, value);
+  }
+  writer.EndObject();
+  return buffer.GetString();
+}
+
+void fail(const std::string& field, const std::string& message) {
+  throw invalidRequest(field, message);
+}
+
+void wrongType(const std::string& field, const char* expected, const Value& got) {
+  fail(field, field + " must be " + expected + ", got " + describe(got));
+}
+
+const Value* find(const Value& object, const char* name) {
+  auto it = object.FindMember(name);
+  return it == object.MemberEnd() ? nullptr : &it->value;
+}
+
+const Value& requireObject(const Value& value, const std::string& field) {
+  if (!value.IsObject()) wrongType(field, "an object", value);
+  return value;
+}
+
+const Value& requireArray(const Value& value, const std::string& field) {
+  if (!value.IsArray()) wrongType(field, "an array", value);
+  return value;
+}
+
+double number(const Value& value, const std::string& field) {
+  if (!value.IsNumber()) wrongType(field, "a number", value);
+  double d = value.GetDouble();
+  if (!std::isfinite(d)) fail(field, field + " must be a finite number");
+  return d;
+}
+
+int integer(const Value& value, const std::string& field) {
+  if (value.IsInt()) return value.GetInt();
+  if (value.IsNumber()) {
+    double d = value.GetDouble();
+    if (std::isfinite(d) && d == std::floor(d) && d >= std::numeric_limits<int>::min() &&
+        d <= std::numeric_limits<int>::max()) {
+      return static_cast<int>(d);
+    }
+    fail(field, field + " must be an integer in the range of a 32-bit int");
+  }
+  wrongType(field, "an integer", value);
+}
+
+bool boolean(const Value& value, const std::string& field) {
+  if (!value.IsBool()) wrongType(field, "true or false", value);
+  return value.GetBool();
+}
+
+std::string_view string(const Value& value, const std::string& field) {
+  if (!value.IsString()) wrongType(field, "a string", value);
+  return {value.GetString(), value.GetStringLength()};
+}
+
+render::Vec3 vec3(const Value& value, const std::string& field) {
+  if (!value.IsArray() || value.Size() != 3) {
+    fail(field, field + " must be an array of 3 numbers, got " +
+                    (value.IsArray() ? "an array of " + std::to_string(value.Size()) + " values"
+                                     : describe(value)));
+  }
+  double c[3];
+  for (rapidjson::SizeType i = 0; i < 3; ++i) {
+    if (!value[i].IsNumber()) fail(field, field + " must be an array of 3 numbers");
+    c[i] = number(value[i], field + "[" + std::to_string(i) + "]");
+  }
+  return {c[0], c[1], c[2]};
+}
+
+void writeNumber(Writer& writer, double value) {
+  // RapidJSON's Writer refuses NaN and infinity after it has already written the separator,
+  // which would leave broken JSON; null is what clients can parse.
+  if (std::isfinite(value)) {
+    writer.Double(value);
+  } else {
+    writer.Null();
+  }
+}
+
+void writeKey(Writer& writer, const char* key) { writer.Key(key); }
+
+void writeString(Writer& writer, std::string_view text) {
+  writer.String(text.data(), static_cast<rapidjson::SizeType>(text.size()));
+}
+
+}  // namespace limn::api::json

@@ -1,0 +1,260 @@
+// parseRenderRequest: the JSON body of POST /v1/render -> RenderRequest, checked against the
+// job limits. Cheap fields first, the mesh last, so that an over-limit image size is refused
+// without reading a large mesh.
+#include <rapidjson/error/en.h>
+
+#include <cmath>
+#include <initializer_list>
+#include <set>
+
+#include "api/json_mesh_reader.h"
+#include "api/json_util.h"
+#include "api/obj_reader.h"
+#include "api/render_api.h"
+
+namespace limn::api {
+
+namespace {
+
+using json::Value;
+using render::pipeline::JobLimits;
+using render::pipeline::Method;
+
+void warnUnknownFields(const Value& object, const std::string& prefix,
+                       std::initializer_list<const char*> known,
+                       std::vector<std::string>& warnings) {
+  for (auto it = object.MemberBegin(); it != object.MemberEnd(); ++it) {
+    std::string_view name(it->name.GetString(), it->name.GetStringLength());
+    bool isKnown = false;
+    for (const char* k : known) isKnown = isKnown || name == k;
+    if (!isKnown) {
+      warnings.push_back(
+          "ignored unknown field " +
+          json::quote(prefix.empty() ? std::string(name) : prefix + "." + std::string(name)));
+    }
+  }
+}
+
+int imageSide(const Value& value, const std::string& field, const JobLimits& limits) {
+  int side = json::integer(value, field);
+  if (side < 1) json::fail(field, field + " must be at least 1, got " + std::to_string(side));
+  if (side > limits.maxImageSide) {
+    throw tooLarge("maxImageSide", field,
+                   field + " " + std::to_string(side) + " exceeds limit maxImageSide (" +
+                       std::to_string(limits.maxImageSide) + ")");
+  }
+  return side;
+}
+
+render::CameraSpec parseCamera(const Value& camera, const JobLimits& limits,
+                               std::vector<std::string>& warnings) {
+  json::requireObject(camera, "camera");
+  warnUnknownFields(
+      camera, "camera",
+      {"eye", "target", "up", "fovYDeg", "projection", "orthoHeight", "width", "height"}, warnings);
+  render::CameraSpec spec;
+  if (const Value* v = json::find(camera, "eye")) spec.eye = json::vec3(*v, "camera.eye");
+  if (const Value* v = json::find(camera, "target")) spec.target = json::vec3(*v, "camera.target");
+  if (const Value* v = json::find(camera, "up")) {
+    spec.up = json::vec3(*v, "camera.up");
+    if (render::length(*spec.up) == 0) json::fail("camera.up", "camera.up must not be zero");
+  }
+  if (const Value* v = json::find(camera, "fovYDeg")) {
+    double fov = json::number(*v, "camera.fovYDeg");
+    if (!(fov > 0 && fov < 180)) {
+      json::fail("camera.fovYDeg", "camera.fovYDeg must be between 0 and 180 (exclusive)");
+    }
+    spec.fovYDeg = fov;
+  }
+  if (const Value* v = json::find(camera, "projection")) {
+    spec.projection =
+        json::choice<render::Projection>(*v, "camera.projection",
+                                         {{"perspective", render::Projection::Perspective},
+                                          {"orthographic", render::Projection::Orthographic}});
+  }
+  if (const Value* v = json::find(camera, "orthoHeight")) {
+    double h = json::number(*v, "camera.orthoHeight");
+    if (!(h > 0)) json::fail("camera.orthoHeight", "camera.orthoHeight must be > 0");
+    spec.orthoHeight = h;
+  }
+  if (const Value* v = json::find(camera, "width")) {
+    spec.width = imageSide(*v, "camera.width", limits);
+  }
+  if (const Value* v = json::find(camera, "height")) {
+    spec.height = imageSide(*v, "camera.height", limits);
+  }
+  return spec;
+}
+
+Method parseMethod(const Value& value) {
+  std::string_view name = json::string(value, "method");
+  if (name == "silhouette" || name == "patches") {
+    json::fail("method", "method " + json::quote(name) +
+                             " is not implemented yet; available: \"coarse\", \"uniform\", "
+                             "\"adaptive\", \"limit\"");
+  }
+  return json::choice<Method>(value, "method",
+                              {{"coarse", Method::Coarse},
+                               {"uniform", Method::Uniform},
+                               {"adaptive", Method::Adaptive},
+                               {"limit", Method::Limit}});
+}
+
+render::pipeline::MethodParams parseParams(const Value& params, const JobLimits& limits,
+                                           std::vector<std::string>& warnings) {
+  json::requireObject(params, "params");
+  warnUnknownFields(params, "params", {"level", "dicingRate", "metricSupersample"}, warnings);
+  render::pipeline::MethodParams out;
+  if (const Value* v = json::find(params, "level")) {
+    out.level = json::integer(*v, "params.level");
+    if (out.level < 0) json::fail("params.level", "params.level must be >= 0");
+    if (out.level > limits.maxLevel) {
+      throw tooLarge("maxLevel", "params.level",
+                     "params.level " + std::to_string(out.level) + " exceeds limit maxLevel (" +
+                         std::to_string(limits.maxLevel) + ")");
+    }
+  }
+  if (const Value* v = json::find(params, "dicingRate")) {
+    out.dicingRate = json::number(*v, "params.dicingRate");
+    if (!(out.dicingRate > 0)) json::fail("params.dicingRate", "params.dicingRate must be > 0");
+    if (out.dicingRate < limits.minDicingRate) {
+      throw tooLarge("minDicingRate", "params.dicingRate",
+                     "params.dicingRate " + json::formatNumber(out.dicingRate) +
+                         " is below limit minDicingRate (" +
+                         json::formatNumber(limits.minDicingRate) + " pixels)");
+    }
+  }
+  if (const Value* v = json::find(params, "metricSupersample")) {
+    out.metricSupersample = json::integer(*v, "params.metricSupersample");
+    if (out.metricSupersample < 1) {
+      json::fail("params.metricSupersample", "params.metricSupersample must be >= 1");
+    }
+    if (out.metricSupersample > limits.maxSupersample) {
+      throw tooLarge("maxSupersample", "params.metricSupersample",
+                     "params.metricSupersample " + std::to_string(out.metricSupersample) +
+                         " exceeds limit maxSupersample (" + std::to_string(limits.maxSupersample) +
+                         ")");
+    }
+  }
+  return out;
+}
+
+render::pipeline::Outputs parseOutputs(const Value& value) {
+  json::requireArray(value, "outputs");
+  render::pipeline::Outputs out;
+  out.color = false;
+  enum Pass { Color, Mask, Depth, Normal, Wireframe };
+  for (rapidjson::SizeType i = 0; i < value.Size(); ++i) {
+    Pass pass = json::choice<Pass>(value[i], "outputs[" + std::to_string(i) + "]",
+                                   {{"color", Color},
+                                    {"mask", Mask},
+                                    {"depth", Depth},
+                                    {"normal", Normal},
+                                    {"wireframe", Wireframe}});
+    bool* flags[] = {&out.color, &out.mask, &out.depth, &out.normal, &out.wireframe};
+    *flags[pass] = true;
+  }
+  return out;
+}
+
+render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
+                                    std::vector<std::string>& warnings) {
+  json::requireObject(mesh, "mesh");
+  std::string_view format = "json";
+  if (const Value* v = json::find(mesh, "format")) format = json::string(*v, "mesh.format");
+  if (format == "obj") {
+    warnUnknownFields(mesh, "mesh", {"format", "data", "scheme"}, warnings);
+    const Value* data = json::find(mesh, "data");
+    if (!data) json::fail("mesh.data", "mesh.data (the OBJ text) is required with format \"obj\"");
+    std::string_view text = json::string(*data, "mesh.data");
+    render::mesh::Scheme scheme = render::mesh::Scheme::CatmullClark;
+    if (const Value* v = json::find(mesh, "scheme")) scheme = readScheme(*v, "mesh.scheme");
+    ObjMesh obj = readObj(text, scheme, limits.mesh);
+    for (std::string& w : obj.warnings) warnings.push_back("mesh " + std::move(w));
+    return std::move(obj.mesh);
+  }
+  if (format == "json") {
+    if (json::find(mesh, "data")) {
+      json::fail("mesh.data",
+                 "mesh.data is read only with format \"obj\"; the JSON form puts "
+                 "points, faceVertexCounts, faceVertexIndices, ... directly in mesh");
+    }
+    warnUnknownFields(
+        mesh, "mesh",
+        {"format", "scheme", "points", "faceVertexCounts", "faceVertexIndices", "creaseIndices",
+         "creaseLengths", "creaseSharpnesses", "cornerIndices", "cornerSharpnesses", "holeIndices",
+         "interpolateBoundary", "creaseMethod", "triangleSubdivision"},
+        warnings);
+    return readJsonMesh(mesh, "mesh", limits.mesh);
+  }
+  json::fail("mesh.format",
+             "mesh.format must be one of \"obj\", \"json\"; got " + json::quote(format));
+}
+
+RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
+  if (!root.IsObject()) {
+    json::fail("", "the request body must be a JSON object, got " + json::describe(root));
+  }
+  RenderRequest request;
+  std::vector<std::string>& warnings = request.warnings;
+  render::pipeline::RenderJob& job = request.job;
+  warnUnknownFields(
+      root, "",
+      {"mesh", "camera", "method", "params", "shading", "outputs", "reference", "imageFormat"},
+      warnings);
+  if (const Value* v = json::find(root, "camera")) job.camera = parseCamera(*v, limits, warnings);
+  if (const Value* v = json::find(root, "method")) job.method = parseMethod(*v);
+  if (const Value* v = json::find(root, "params")) job.params = parseParams(*v, limits, warnings);
+  if (const Value* v = json::find(root, "shading")) {
+    job.shading = json::choice<render::Shading>(
+        *v, "shading", {{"flat", render::Shading::Flat}, {"smooth", render::Shading::Smooth}});
+  }
+  if (const Value* v = json::find(root, "outputs")) job.outputs = parseOutputs(*v);
+  if (const Value* v = json::find(root, "reference"))
+    job.reference = json::boolean(*v, "reference");
+  if (const Value* v = json::find(root, "imageFormat")) {
+    request.imageFormat = json::choice<render::image::Format>(
+        *v, "imageFormat",
+        {{"png", render::image::Format::Png}, {"exr", render::image::Format::Exr}});
+  }
+
+  const Value* mesh = json::find(root, "mesh");
+  if (!mesh) json::fail("mesh", "mesh is required");
+  job.mesh = parseMesh(*mesh, limits, warnings);
+
+  // The view needs a direction: an eye on the target (given, or the mesh's centre) has none.
+  if (job.camera.eye) {
+    render::Vec3 target = job.camera.target.value_or(job.mesh.bounds().center());
+    if (render::length(*job.camera.eye - target) == 0) {
+      json::fail("camera.eye", "camera.eye is at the camera target: the view has no direction");
+    }
+  }
+  return request;
+}
+
+}  // namespace
+
+RenderRequest parseRenderRequest(std::string_view body, const JobLimits& limits) {
+  rapidjson::Document document;
+  // Iterative parsing: a deeply nested body must not exhaust the stack. UTF-8 is validated so
+  // that text echoed back in messages is valid JSON.
+  constexpr unsigned kFlags = rapidjson::kParseIterativeFlag |
+                              rapidjson::kParseValidateEncodingFlag |
+                              rapidjson::kParseFullPrecisionFlag;
+  document.Parse<kFlags>(body.data(), body.size());
+  if (document.HasParseError()) {
+    size_t offset = document.GetErrorOffset();
+    throw ApiError{400, "invalid_json",
+                   std::string("the request body is not valid JSON: ") +
+                       rapidjson::GetParseError_En(document.GetParseError()) + " (at offset " +
+                       std::to_string(offset) + ")",
+                   "{\"offset\": " + std::to_string(offset) + "}"};
+  }
+  try {
+    return parseDocument(document, limits);
+  } catch (const render::InputError& error) {
+    throw fromInputError(error);
+  }
+}
+
+}  // namespace limn::api

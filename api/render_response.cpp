@@ -1,0 +1,210 @@
+// writeRenderResponse: RenderResult -> the 200 answer's JSON, in DESIGN.md's shape. Images are
+// encoded (PNG or EXR) and carried as base64; numbers that are not finite are written as null.
+#include <chrono>
+
+#include "api/base64.h"
+#include "api/json_util.h"
+#include "api/render_api.h"
+
+namespace limn::api {
+
+namespace {
+
+using json::writeNumber;
+using json::Writer;
+using render::pipeline::Outputs;
+
+void numberField(Writer& w, const char* key, double value) {
+  w.Key(key);
+  writeNumber(w, value);
+}
+
+// The order images appear in the answer.
+std::vector<const char*> requestedPasses(const Outputs& outputs) {
+  std::vector<const char*> names;
+  if (outputs.color) names.push_back(render::pass::kColor);
+  if (outputs.mask) names.push_back(render::pass::kMask);
+  if (outputs.depth) names.push_back(render::pass::kDepth);
+  if (outputs.normal) names.push_back(render::pass::kNormal);
+  if (outputs.wireframe) names.push_back(render::pass::kWireframe);
+  return names;
+}
+
+void writeImages(Writer& w, const render::ImageSet& images, const RenderRequest& request,
+                 const char* owner, std::vector<std::string>& warnings) {
+  w.StartObject();
+  for (const char* name : requestedPasses(request.job.outputs)) {
+    const render::Image* image = images.find(name);
+    if (!image || image->empty()) {
+      warnings.push_back(std::string("output \"") + name + "\" was requested but the " + owner +
+                         " did not produce it");
+      continue;
+    }
+    render::image::EncodedImage encoded = render::image::encode(*image, name, request.imageFormat);
+    w.Key(name);
+    w.StartObject();
+    w.Key("mime");
+    json::writeString(w, encoded.mime);
+    w.Key("width");
+    w.Int(encoded.width);
+    w.Key("height");
+    w.Int(encoded.height);
+    w.Key("data");
+    std::string data = encodeBase64(encoded.bytes);
+    // Base64 needs no escaping: skip the writer's per-character scan of a large string.
+    w.RawValue(("\"" + data + "\"").c_str(), data.size() + 2, rapidjson::kStringType);
+    w.EndObject();
+  }
+  w.EndObject();
+}
+
+void writeMetrics(Writer& w, const render::metrics::Metrics& m) {
+  w.StartObject();
+  if (m.silhouette) {
+    w.Key("silhouette");
+    w.StartObject();
+    numberField(w, "hausdorffPx", m.silhouette->hausdorffPx);
+    numberField(w, "meanPx", m.silhouette->meanPx);
+    numberField(w, "iou", m.silhouette->iou);
+    w.Key("mismatchPx");
+    w.Int64(m.silhouette->mismatchPx);
+    w.EndObject();
+  }
+  if (m.image) {
+    w.Key("image");
+    w.StartObject();
+    numberField(w, "rmse", m.image->rmse);
+    numberField(w, "psnr", m.image->psnr);
+    w.EndObject();
+  }
+  if (m.depth) {
+    w.Key("depth");
+    w.StartObject();
+    numberField(w, "maxRel", m.depth->maxRel);
+    numberField(w, "meanRel", m.depth->meanRel);
+    w.EndObject();
+  }
+  if (m.normal) {
+    w.Key("normal");
+    w.StartObject();
+    numberField(w, "meanDeg", m.normal->meanDeg);
+    numberField(w, "maxDeg", m.normal->maxDeg);
+    w.EndObject();
+  }
+  if (m.geometry) {
+    w.Key("geometry");
+    w.StartObject();
+    numberField(w, "maxDist", m.geometry->maxDist);
+    numberField(w, "meanDist", m.geometry->meanDist);
+    numberField(w, "relMaxDist", m.geometry->relMaxDist);
+    w.EndObject();
+  }
+  w.EndObject();
+}
+
+void writeStats(Writer& w, const render::pipeline::Stats& s) {
+  w.StartObject();
+  w.Key("controlVertices");
+  w.Int(s.controlVertices);
+  w.Key("controlFaces");
+  w.Int(s.controlFaces);
+  w.Key("triangles");
+  w.Uint64(s.triangles);
+  w.Key("vertices");
+  w.Uint64(s.vertices);
+  w.Key("patches");
+  w.Uint64(s.patches);
+  w.Key("referenceTriangles");
+  w.Uint64(s.referenceTriangles);
+  if (s.referenceCrossCheckPx) {
+    numberField(w, "referenceCrossCheckPx", *s.referenceCrossCheckPx);
+  }
+  w.EndObject();
+}
+
+void writeVec3(Writer& w, const render::Vec3& v) {
+  w.StartArray();
+  writeNumber(w, v.x);
+  writeNumber(w, v.y);
+  writeNumber(w, v.z);
+  w.EndArray();
+}
+
+void writeCamera(Writer& w, const render::Camera& c) {
+  w.StartObject();
+  w.Key("eye");
+  writeVec3(w, c.eye());
+  w.Key("target");
+  writeVec3(w, c.target());
+  w.Key("up");
+  writeVec3(w, c.up());
+  numberField(w, "fovYDeg", c.fovYDeg());
+  w.Key("projection");
+  w.String(c.projection() == render::Projection::Perspective ? "perspective" : "orthographic");
+  numberField(w, "orthoHeight", c.orthoHeight());
+  w.Key("width");
+  w.Int(c.width());
+  w.Key("height");
+  w.Int(c.height());
+  w.EndObject();
+}
+
+}  // namespace
+
+std::string writeRenderResponse(const render::pipeline::RenderResult& result,
+                                const RenderRequest& request) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  std::vector<std::string> warnings = request.warnings;
+  warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
+
+  rapidjson::StringBuffer buffer;
+  Writer w(buffer);
+  w.StartObject();
+  w.Key("images");
+  writeImages(w, result.images, request, "method", warnings);
+  if (request.job.reference) {
+    w.Key("reference");
+    w.StartObject();
+    w.Key("images");
+    if (result.referenceImages) {
+      writeImages(w, *result.referenceImages, request, "reference", warnings);
+    } else {
+      w.StartObject();
+      w.EndObject();
+      warnings.push_back("the reference was requested but not produced");
+    }
+    w.EndObject();
+  }
+  const double encodeMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+
+  w.Key("metrics");
+  writeMetrics(w, result.metrics);
+  w.Key("stats");
+  writeStats(w, result.stats);
+
+  const render::pipeline::Timings& t = result.timings;
+  w.Key("timings");
+  w.StartObject();
+  numberField(w, "parseMs", t.parseMs);
+  numberField(w, "surfaceMs", t.surfaceMs);
+  numberField(w, "approxMs", t.approxMs);
+  numberField(w, "rasterMs", t.rasterMs);
+  numberField(w, "referenceMs", t.referenceMs);
+  numberField(w, "metricsMs", t.metricsMs);
+  numberField(w, "encodeMs", encodeMs);
+  numberField(w, "totalMs", t.parseMs + t.totalMs + encodeMs);
+  w.EndObject();
+
+  w.Key("warnings");
+  w.StartArray();
+  for (const std::string& warning : warnings) json::writeString(w, warning);
+  w.EndArray();
+
+  w.Key("camera");
+  writeCamera(w, result.camera);
+  w.EndObject();
+  return {buffer.GetString(), buffer.GetSize()};
+}
+
+}  // namespace limn::api
