@@ -1,0 +1,286 @@
+// limn: the command line. `limn serve` runs the HTTP service; `limn render` runs one request
+// file through the same engine without HTTP and writes the answer and its images to a folder.
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "api/config.h"
+#include "api/render_api.h"
+#include "render/core/error.h"
+#include "render/image/encode.h"
+#include "render/pipeline/render_job.h"
+#include "render/raster/rasterizer.h"
+#include "server/http_server.h"
+#include "server/router.h"
+#include "server/worker_pool.h"
+
+#ifndef LIMN_VERSION
+#define LIMN_VERSION "unknown"
+#endif
+
+namespace {
+
+using namespace limn;
+
+constexpr const char* kHelp =
+    R"(limn )" LIMN_VERSION R"( - renders smooth (subdivision) surfaces over HTTP
+
+Usage:
+  limn serve [--listen HOST:PORT] [--config FILE] [--workers N]
+      Runs the HTTP service. Defaults: 127.0.0.1:8080, built-in configuration, one render
+      worker per core. Port 0 picks a free port. Once it accepts connections it prints
+        limn listening on http://HOST:PORT
+      on stdout. SIGINT or SIGTERM shut it down cleanly (exit status 0).
+      Endpoints: POST /v1/render, GET /healthz, /readyz, /metrics, /openapi.json.
+
+  limn render REQUEST.json --out DIR [--config FILE]
+      Runs one /v1/render request body through the engine without HTTP and writes
+        DIR/response.json         the JSON answer (images as base64, metrics, timings)
+        DIR/<pass>.png|exr        each requested image (color, mask, depth, normal, wireframe)
+        DIR/reference_<pass>.*    the reference's images, when the request asks for them
+      A request the service would refuse exits with status 2 and its JSON error on stderr.
+
+  limn help | --help      this text
+  limn --version          the version
+
+Exit status: 0 success, 1 usage or configuration error, 2 bad request, 3 render failure.
+)";
+
+int usageError(const std::string& message) {
+  std::cerr << "limn: " << message << "\n(see limn --help)\n";
+  return 1;
+}
+
+// Parses "HOST:PORT", "[V6]:PORT" or ":PORT" (all interfaces is then 0.0.0.0).
+bool parseListen(const std::string& text, std::string& host, unsigned short& port) {
+  auto colon = text.rfind(':');
+  if (colon == std::string::npos) return false;
+  std::string h = text.substr(0, colon), p = text.substr(colon + 1);
+  if (h.size() >= 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
+  if (h.empty()) h = "0.0.0.0";
+  if (p.empty() || p.find_first_not_of("0123456789") != std::string::npos || p.size() > 5) {
+    return false;
+  }
+  unsigned long value = std::stoul(p);
+  if (value > 65535) return false;
+  host = h;
+  port = static_cast<unsigned short>(value);
+  return true;
+}
+
+std::optional<std::string> readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Options shared by both commands; each parses its own positional arguments.
+struct CommandLine {
+  std::vector<std::string> positional;
+  std::optional<std::string> listen, config, workers, out;
+};
+
+std::optional<CommandLine> parseArguments(int argc, char** argv, int first, std::string& error) {
+  CommandLine cl;
+  for (int i = first; i < argc; ++i) {
+    std::string arg = argv[i];
+    std::optional<std::string>* target = nullptr;
+    if (arg == "--listen") target = &cl.listen;
+    if (arg == "--config") target = &cl.config;
+    if (arg == "--workers") target = &cl.workers;
+    if (arg == "--out") target = &cl.out;
+    if (target) {
+      if (i + 1 >= argc) {
+        error = arg + " needs a value";
+        return std::nullopt;
+      }
+      *target = argv[++i];
+    } else if (arg.size() > 1 && arg[0] == '-') {
+      error = "unknown option " + arg;
+      return std::nullopt;
+    } else {
+      cl.positional.push_back(arg);
+    }
+  }
+  return cl;
+}
+
+std::optional<api::ServiceConfig> loadConfiguration(const CommandLine& cl) {
+  if (!cl.config) return api::ServiceConfig{};
+  try {
+    return api::loadConfig(*cl.config);
+  } catch (const api::ApiError& e) {
+    std::cerr << "limn: configuration " << *cl.config << ": " << e.message << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "limn: configuration " << *cl.config << ": " << e.what() << "\n";
+  }
+  return std::nullopt;
+}
+
+int serve(const CommandLine& cl) {
+  if (!cl.positional.empty()) return usageError("serve takes no argument " + cl.positional[0]);
+  auto config = loadConfiguration(cl);
+  if (!config) return 1;
+  if (cl.out) return usageError("--out belongs to limn render");
+  if (cl.listen) {
+    std::string host;
+    unsigned short port = 0;
+    if (!parseListen(*cl.listen, host, port)) {
+      return usageError("--listen wants HOST:PORT, got " + *cl.listen);
+    }
+    config->host = host;
+    config->port = port;
+  }
+  if (cl.workers) {
+    try {
+      config->workers = std::stoi(*cl.workers);
+    } catch (const std::exception&) {
+      return usageError("--workers wants a number, got " + *cl.workers);
+    }
+    if (config->workers < 0) return usageError("--workers must be 0 (one per core) or more");
+  }
+
+  server::PoolOptions poolOptions;
+  poolOptions.workers = config->workers;
+  poolOptions.queueDepth = config->queueDepth;
+  poolOptions.timeout = std::chrono::milliseconds(config->requestTimeoutMs);
+  server::WorkerPool pool(poolOptions);
+  for (size_t i = 0; i < pool.workerStatus().size(); ++i) {
+    const auto& w = pool.workerStatus()[i];
+    if (!w.ready)
+      std::cerr << "limn: worker " << i << " has no OpenGL context: " << w.error << "\n";
+  }
+  if (!pool.workerStatus().empty() && pool.workerStatus().front().ready) {
+    const auto& device = pool.workerStatus().front().device;
+    std::cerr << "limn: " << pool.workerStatus().size() << " render workers on " << device.renderer
+              << " (EGL " << device.eglPlatform << ")\n";
+  }
+
+  server::Router router(config->limits, pool);
+  server::HttpOptions httpOptions;
+  httpOptions.host = config->host;
+  httpOptions.port = config->port;
+  httpOptions.ioThreads = config->ioThreads;
+  httpOptions.maxBodyBytes = config->maxBodyBytes;
+  std::optional<server::HttpServer> http;
+  try {
+    http.emplace(httpOptions, router, pool);
+  } catch (const std::exception& e) {
+    std::cerr << "limn: " << e.what() << "\n";
+    return 1;
+  }
+
+  std::string host = http->host();
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  std::cout << "limn listening on http://" << host << ":" << http->port() << std::endl;
+  http->run();
+  pool.join();
+  std::cerr << "limn: stopped\n";
+  return 0;
+}
+
+void writeFile(const std::filesystem::path& path, const void* data, size_t size) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+int fail(const api::ApiError& error, int status) {
+  std::cerr << api::errorAnswer(error).body << "\n";
+  return status;
+}
+
+int renderCommand(const CommandLine& cl) {
+  if (cl.positional.size() != 1) return usageError("render wants one REQUEST.json");
+  if (!cl.out) return usageError("render wants --out DIR");
+  if (cl.listen || cl.workers) return usageError("--listen and --workers belong to limn serve");
+  auto config = loadConfiguration(cl);
+  if (!config) return 1;
+  auto text = readFile(cl.positional[0]);
+  if (!text) return usageError("cannot read " + cl.positional[0]);
+
+  api::RenderRequest request;
+  try {
+    request = api::parseRenderRequest(*text, config->limits);
+  } catch (const api::ApiError& e) {
+    return fail(e, 2);
+  }
+
+  std::optional<render::pipeline::RenderResult> result;  // RenderResult has no empty state
+  try {
+    render::raster::Rasterizer rasterizer;
+    render::pipeline::RenderContext context;
+    context.rasterizer = &rasterizer;
+    result = render::pipeline::run(request.job, config->limits, context, render::CancelToken{});
+  } catch (const render::InputError& e) {
+    return fail(api::fromInputError(e), 2);
+  } catch (const std::exception& e) {
+    return fail({500, "internal", std::string("render failed: ") + e.what()}, 3);
+  }
+
+  try {
+    std::filesystem::path dir(*cl.out);
+    std::filesystem::create_directories(dir);
+    std::string json = api::writeRenderResponse(*result, request);
+    writeFile(dir / "response.json", json.data(), json.size());
+    std::vector<std::string> written{(dir / "response.json").string()};
+    auto writeSet = [&](const render::ImageSet& set, const std::string& prefix) {
+      for (const auto& [name, image] : set.passes) {
+        auto encoded = render::image::encode(image, name, request.imageFormat);
+        const char* ext = request.imageFormat == render::image::Format::Exr ? ".exr" : ".png";
+        auto path = dir / (prefix + name + ext);
+        writeFile(path, encoded.bytes.data(), encoded.bytes.size());
+        written.push_back(path.string());
+      }
+    };
+    writeSet(result->images, "");
+    if (result->referenceImages) writeSet(*result->referenceImages, "reference_");
+    for (const auto& path : written) std::cout << path << "\n";
+  } catch (const std::exception& e) {
+    return fail({500, "internal", e.what()}, 3);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // A client that hangs up mid-answer, or a parent that stops reading stdout, must not kill
+  // the server: writes then fail with EPIPE instead.
+  std::signal(SIGPIPE, SIG_IGN);
+
+  if (argc < 2) {
+    std::cerr << kHelp;
+    return 1;
+  }
+  std::string command = argv[1];
+  if (command == "--help" || command == "-h" || command == "help") {
+    std::cout << kHelp;
+    return 0;
+  }
+  if (command == "--version") {
+    std::cout << "limn " << LIMN_VERSION << "\n";
+    return 0;
+  }
+  if (command != "serve" && command != "render") return usageError("unknown command " + command);
+
+  std::string error;
+  auto cl = parseArguments(argc, argv, 2, error);
+  if (!cl) return usageError(error);
+  try {
+    return command == "serve" ? serve(*cl) : renderCommand(*cl);
+  } catch (const std::exception& e) {
+    std::cerr << "limn: " << e.what() << "\n";
+    return 3;
+  }
+}

@@ -1,0 +1,233 @@
+#include "server/router.h"
+
+#include <cstdio>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "api/openapi.h"
+
+#ifndef LIMN_VERSION
+#define LIMN_VERSION "unknown"
+#endif
+
+namespace limn::server {
+
+namespace {
+
+struct Route {
+  const char* path;
+  const char* method;
+};
+
+// Every (path, method) limn answers; a known path with another method is a 405 listing these.
+constexpr Route kRoutes[] = {
+    {"/healthz", "GET"},      {"/readyz", "GET"},     {"/metrics", "GET"},
+    {"/openapi.json", "GET"}, {"/v1/render", "POST"},
+};
+
+// The few JSON strings the service endpoints write (renderer names, error texts) go through
+// this; the request and response documents themselves belong to api/.
+std::string jsonString(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+// Prometheus label values escape backslash, quote and newline.
+std::string labelValue(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '\\' || c == '"') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+api::Answer jsonAnswer(int status, std::string body) {
+  api::Answer answer;
+  answer.status = status;
+  answer.body = std::move(body);
+  return answer;
+}
+
+}  // namespace
+
+std::string_view pathOf(std::string_view target) {
+  return target.substr(0, target.find_first_of("?#"));
+}
+
+std::string Router::routeLabel(std::string_view target) {
+  std::string_view path = pathOf(target);
+  for (const Route& route : kRoutes) {
+    if (path == route.path) return std::string(path);
+  }
+  return "other";
+}
+
+Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool)
+    : limits_(limits), pool_(pool), started_(std::chrono::steady_clock::now()) {}
+
+void Router::handle(Request request, Reply reply) {
+  std::string_view path = pathOf(request.target);
+  std::vector<std::string> allowed;
+  for (const Route& route : kRoutes) {
+    if (path == route.path) allowed.emplace_back(route.method);
+  }
+  if (allowed.empty()) {
+    reply(api::errorAnswer({404, "not_found", "no such endpoint: " + std::string(path),
+                            "{\"path\":" + jsonString(path) + "}"}));
+    return;
+  }
+  bool methodAllowed = false;
+  for (const auto& m : allowed) methodAllowed = methodAllowed || m == request.method;
+  if (!methodAllowed) {
+    std::string allow;
+    for (const auto& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
+    api::Answer answer = api::errorAnswer(
+        {405, "method_not_allowed",
+         request.method + " is not allowed on " + std::string(path) + "; use " + allow,
+         "{\"allow\":" + jsonString(allow) + "}"});
+    answer.headers.emplace_back("Allow", allow);
+    reply(std::move(answer));
+    return;
+  }
+
+  if (path == "/healthz") return reply(healthz());
+  if (path == "/readyz") return reply(readyz());
+  if (path == "/metrics") return reply(metrics());
+  if (path == "/openapi.json") return reply(jsonAnswer(200, std::string(api::openApiDocument())));
+  render(std::move(request.body), std::move(reply));
+}
+
+void Router::render(std::string body, Reply reply) {
+  pool_.submit(
+      [body = std::move(body), limits = limits_](render::pipeline::RenderContext& context,
+                                                 const render::CancelToken& cancel) {
+        return api::handleRender(body, limits, context, cancel);
+      },
+      std::move(reply));
+}
+
+api::Answer Router::healthz() const {
+  PoolSnapshot pool = pool_.snapshot();
+  const auto& workers = pool_.workerStatus();
+
+  // Every worker runs the same driver; report the first one that has a context, and the
+  // errors of those that do not.
+  const render::raster::DeviceInfo* device = nullptr;
+  std::string errors;
+  for (const auto& w : workers) {
+    if (w.ready && !device) device = &w.device;
+    if (!w.ready) errors += (errors.empty() ? "" : ",") + jsonString(w.error);
+  }
+  bool ok = pool.readyWorkers == pool.workers && !pool.stopping;
+  double uptime =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+
+  std::ostringstream out;
+  out << "{\"status\":" << jsonString(ok ? "ok" : "degraded")
+      << ",\"version\":" << jsonString(LIMN_VERSION)
+      << ",\"renderer\":" << jsonString(device ? device->renderer : "")
+      << ",\"glVendor\":" << jsonString(device ? device->vendor : "")
+      << ",\"glVersion\":" << jsonString(device ? device->version : "")
+      << ",\"eglPlatform\":" << jsonString(device ? device->eglPlatform : "")
+      << ",\"workers\":" << pool.workers << ",\"readyWorkers\":" << pool.readyWorkers
+      << ",\"busyWorkers\":" << pool.busyWorkers << ",\"queueDepth\":" << pool.queued
+      << ",\"queueCapacity\":" << pool.queueCapacity << ",\"uptimeS\":" << uptime << ",\"errors\":["
+      << errors << "]}";
+  return jsonAnswer(200, out.str());
+}
+
+api::Answer Router::readyz() const {
+  PoolSnapshot pool = pool_.snapshot();
+  std::string reason;
+  if (pool.stopping) {
+    reason = "shutting down";
+  } else if (pool.readyWorkers == 0) {
+    reason = "no render worker has an OpenGL context";
+  } else if (pool.queued >= pool.queueCapacity) {
+    reason = "render queue full";
+  }
+  if (reason.empty()) return jsonAnswer(200, "{\"ready\":true}");
+  return jsonAnswer(503, "{\"ready\":false,\"reason\":" + jsonString(reason) + "}");
+}
+
+api::Answer Router::metrics() const {
+  PoolSnapshot pool = pool_.snapshot();
+  std::ostringstream out;
+  out << "# HELP limn_requests_total HTTP requests answered, by route and status.\n"
+         "# TYPE limn_requests_total counter\n";
+  for (const auto& [key, count] : stats_.answers()) {
+    out << "limn_requests_total{path=\"" << labelValue(key.first) << "\",status=\"" << key.second
+        << "\"} " << count << "\n";
+  }
+  out << "# HELP limn_request_duration_seconds Time from a request's headers to its answer.\n"
+         "# TYPE limn_request_duration_seconds summary\n";
+  for (const auto& [route, d] : stats_.durations()) {
+    out << "limn_request_duration_seconds_sum{path=\"" << labelValue(route) << "\"} "
+        << d.secondsSum << "\n"
+        << "limn_request_duration_seconds_count{path=\"" << labelValue(route) << "\"} " << d.count
+        << "\n";
+  }
+  out << "# HELP limn_render_seconds Time workers spent running render jobs.\n"
+         "# TYPE limn_render_seconds summary\n"
+      << "limn_render_seconds_sum " << pool.renderSecondsSum << "\n"
+      << "limn_render_seconds_count " << pool.renderCount << "\n"
+      << "# HELP limn_queue_depth Render jobs waiting for a worker.\n"
+         "# TYPE limn_queue_depth gauge\n"
+      << "limn_queue_depth " << pool.queued << "\n"
+      << "# HELP limn_queue_capacity Render jobs that may wait before requests get 429.\n"
+         "# TYPE limn_queue_capacity gauge\n"
+      << "limn_queue_capacity " << pool.queueCapacity << "\n"
+      << "# HELP limn_workers Render worker threads, by whether they hold a GL context.\n"
+         "# TYPE limn_workers gauge\n"
+      << "limn_workers{state=\"ready\"} " << pool.readyWorkers << "\n"
+      << "limn_workers{state=\"failed\"} " << pool.workers - pool.readyWorkers << "\n"
+      << "# HELP limn_workers_busy Render workers running a job now.\n"
+         "# TYPE limn_workers_busy gauge\n"
+      << "limn_workers_busy " << pool.busyWorkers << "\n"
+      << "# HELP limn_render_jobs_refused_total Render jobs not run to completion, by reason.\n"
+         "# TYPE limn_render_jobs_refused_total counter\n"
+      << "limn_render_jobs_refused_total{reason=\"busy\"} " << pool.rejectedBusy << "\n"
+      << "limn_render_jobs_refused_total{reason=\"timeout\"} " << pool.timedOut << "\n"
+      << "limn_render_jobs_refused_total{reason=\"shutdown\"} " << pool.cancelled << "\n";
+
+  api::Answer answer;
+  answer.status = 200;
+  answer.contentType = "text/plain; version=0.0.4; charset=utf-8";
+  answer.body = out.str();
+  return answer;
+}
+
+}  // namespace limn::server

@@ -1,0 +1,63 @@
+// Router: what limn does with one HTTP request, with no socket in sight.
+//
+// The HTTP layer hands it (method, target, body) and a reply callback; the router answers the
+// service endpoints at once (/healthz, /readyz, /metrics, /openapi.json), sends renders to the
+// WorkerPool, and answers 404/405 JSON for everything else. Tests call it directly.
+//
+//   GET  /healthz       liveness and what the workers run on
+//   GET  /readyz        200 when a render would be accepted now, else 503
+//   GET  /metrics       Prometheus text format
+//   GET  /openapi.json  the API description
+//   POST /v1/render     api::handleRender on a worker thread
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include "api/render_api.h"
+#include "render/pipeline/render_job.h"
+#include "server/request_stats.h"
+#include "server/worker_pool.h"
+
+namespace limn::server {
+
+struct Request {
+  std::string method;  // as sent: "GET", "POST", ...
+  std::string target;  // path, possibly with "?query"
+  std::string body;
+};
+
+class Router {
+ public:
+  using Reply = std::function<void(api::Answer)>;
+
+  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool);
+
+  // Calls `reply` exactly once: before returning for everything but renders, from a worker or
+  // the pool's watchdog for renders.
+  void handle(Request request, Reply reply);
+
+  // The label a request's path gets in /metrics: the path when limn serves it, else "other".
+  static std::string routeLabel(std::string_view target);
+
+  // The HTTP layer records every answer it writes here.
+  RequestStats& stats() { return stats_; }
+
+ private:
+  api::Answer healthz() const;
+  api::Answer readyz() const;
+  api::Answer metrics() const;
+  void render(std::string body, Reply reply);
+
+  render::pipeline::JobLimits limits_;
+  WorkerPool& pool_;
+  RequestStats stats_;
+  std::chrono::steady_clock::time_point started_;
+};
+
+// The path part of a request target ("/v1/render?x=1" -> "/v1/render").
+std::string_view pathOf(std::string_view target);
+
+}  // namespace limn::server

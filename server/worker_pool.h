@@ -1,0 +1,118 @@
+// WorkerPool: the fixed set of render threads behind POST /v1/render.
+//
+// Each worker constructs its own raster::Rasterizer (an EGL context is bound to the thread that
+// made it) when it starts, then takes jobs from one bounded queue. The pool owns every rule about
+// a job's life that does not depend on HTTP framing:
+//  - admission: a full queue answers 429 busy (with Retry-After) at once, a stopped pool or one
+//    without a single working GL context answers 503 unavailable;
+//  - deadline: each job gets a CancelToken with deadline now + timeout; a watchdog thread
+//    answers 504 timeout the moment the deadline passes, whether the job is still queued
+//    (it leaves the queue) or running (its token is cancelled and the worker drops its result);
+//  - shutdown: stop() answers every queued and running job 503 and cancels the running ones.
+// Whatever happens, a job's reply is called exactly once, from whichever thread settled it
+// (a worker, the watchdog, or the submitter for an immediate refusal).
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <unordered_set>
+#include <vector>
+
+#include "api/render_api.h"
+#include "render/core/cancel.h"
+#include "render/pipeline/render_job.h"
+#include "render/raster/rasterizer.h"
+
+namespace limn::server {
+
+struct PoolOptions {
+  int workers = 0;                            // 0 = one per core
+  size_t queueDepth = 64;                     // jobs waiting, not counting running ones
+  std::chrono::milliseconds timeout{60'000};  // per job, from submission
+};
+
+// What one worker thread reported when it tried to make its GL context.
+struct WorkerStatus {
+  bool ready = false;
+  std::string error;  // why the Rasterizer could not be made, when !ready
+  render::raster::DeviceInfo device;
+};
+
+// A snapshot of the pool's counters for /healthz, /readyz and /metrics.
+struct PoolSnapshot {
+  int workers = 0;       // threads started
+  int readyWorkers = 0;  // threads holding a GL context
+  int busyWorkers = 0;
+  size_t queued = 0;
+  size_t queueCapacity = 0;
+  bool stopping = false;
+  double renderSecondsSum = 0;  // time workers spent inside jobs
+  size_t renderCount = 0;
+  size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
+};
+
+class WorkerPool {
+ public:
+  using Work =
+      std::function<api::Answer(render::pipeline::RenderContext&, const render::CancelToken&)>;
+  using Reply = std::function<void(api::Answer)>;
+
+  // Starts the workers and returns once each has made its GL context or failed to.
+  explicit WorkerPool(const PoolOptions& options);
+  ~WorkerPool();  // stop() then join()
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  // Queues `work`; `reply` gets its answer, or the 429/503/504 the pool gives instead.
+  // `work` must not throw (a throw becomes 500 internal anyway).
+  void submit(Work work, Reply reply);
+
+  // Refuses new jobs, answers queued and running ones 503 and cancels the running ones.
+  // Does not block; join() waits for the threads.
+  void stop();
+  void join();
+
+  // ---- Introspection ----
+  PoolSnapshot snapshot() const;
+  const std::vector<WorkerStatus>& workerStatus() const { return status_; }
+  const PoolOptions& options() const { return options_; }
+
+ private:
+  struct Job;
+  using Deadlines = std::multimap<render::CancelToken::Clock::time_point, std::shared_ptr<Job>>;
+
+  void workerLoop(render::raster::Rasterizer& rasterizer);
+  void watchdogMain();
+  // Marks a job settled under the lock and hands back its reply, or nothing when it was settled
+  // already (the watchdog and a worker can race for the same job).
+  Reply claimLocked(Job& job);
+  int retryAfterSecondsLocked() const;
+
+  PoolOptions options_;
+  std::vector<WorkerStatus> status_;  // written before the constructor returns, then read-only
+  std::vector<std::thread> workers_;
+  std::thread watchdog_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable workAvailable_;
+  std::condition_variable deadlinesChanged_;
+  std::deque<std::shared_ptr<Job>> queue_;
+  std::unordered_set<std::shared_ptr<Job>> running_;
+  Deadlines deadlines_;
+  bool stopping_ = false;
+  int readyWorkers_ = 0;
+  int busyWorkers_ = 0;
+  double renderSecondsSum_ = 0;
+  size_t renderCount_ = 0;
+  size_t rejectedBusy_ = 0, timedOut_ = 0, cancelled_ = 0;
+};
+
+}  // namespace limn::server

@@ -1,0 +1,334 @@
+// The server's logic without a network: the WorkerPool's admission, deadline and shutdown
+// rules, and the Router's answers. (tests/integration drives the real process over HTTP.)
+#include <gtest/gtest.h>
+#include <rapidjson/document.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <future>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "api/render_api.h"
+#include "server/router.h"
+#include "server/worker_pool.h"
+
+namespace limn::server {
+namespace {
+
+using namespace std::chrono_literals;
+using render::CancelToken;
+using render::pipeline::RenderContext;
+
+// A reply that can be waited for and that counts how often it was called.
+struct Captured {
+  std::promise<api::Answer> promise;
+  std::future<api::Answer> future = promise.get_future();
+  std::atomic<int> calls{0};
+
+  WorkerPool::Reply reply() {
+    return [this](api::Answer answer) {
+      if (calls.fetch_add(1) == 0) promise.set_value(std::move(answer));
+    };
+  }
+  api::Answer wait(std::chrono::milliseconds timeout = 30s) {
+    if (future.wait_for(timeout) != std::future_status::ready) {
+      ADD_FAILURE() << "no reply within " << timeout.count() << " ms";
+      return {};
+    }
+    return future.get();
+  }
+};
+
+// A gate that jobs block on until the test opens it.
+class Gate {
+ public:
+  void open() {
+    std::lock_guard lock(mutex_);
+    open_ = true;
+    cv_.notify_all();
+  }
+  void wait() {
+    std::unique_lock lock(mutex_);
+    cv_.wait(lock, [this] { return open_; });
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool open_ = false;
+};
+
+std::string errorCode(const api::Answer& answer) {
+  rapidjson::Document doc;
+  doc.Parse(answer.body.c_str());
+  if (doc.HasParseError() || !doc.IsObject() || !doc.HasMember("error")) return "<not an error>";
+  return doc["error"]["code"].GetString();
+}
+
+std::string headerOf(const api::Answer& answer, const std::string& name) {
+  for (const auto& [n, v] : answer.headers) {
+    if (n == name) return v;
+  }
+  return "";
+}
+
+PoolOptions options(int workers, size_t queueDepth, std::chrono::milliseconds timeout = 30s) {
+  PoolOptions o;
+  o.workers = workers;
+  o.queueDepth = queueDepth;
+  o.timeout = timeout;
+  return o;
+}
+
+api::Answer ok(const char* body = "{}") {
+  api::Answer a;
+  a.body = body;
+  return a;
+}
+
+TEST(WorkerPool, RunsJobsOnWorkersThatOwnARasterizer) {
+  WorkerPool pool(options(2, 4));
+  ASSERT_EQ(pool.snapshot().readyWorkers, 2) << pool.workerStatus()[0].error;
+  EXPECT_FALSE(pool.workerStatus()[0].device.renderer.empty());
+
+  Captured captured;
+  std::thread::id caller = std::this_thread::get_id();
+  pool.submit(
+      [caller](RenderContext& context, const CancelToken&) {
+        EXPECT_NE(context.rasterizer, nullptr);
+        EXPECT_NE(std::this_thread::get_id(), caller);
+        return ok("{\"done\":true}");
+      },
+      captured.reply());
+  api::Answer answer = captured.wait();
+  EXPECT_EQ(answer.status, 200);
+  EXPECT_EQ(answer.body, "{\"done\":true}");
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(captured.calls, 1);
+  EXPECT_EQ(pool.snapshot().renderCount, 1u);
+}
+
+TEST(WorkerPool, FullQueueAnswers429WithRetryAfterAtOnce) {
+  WorkerPool pool(options(1, 1));
+  Gate gate;
+  auto blocked = [&gate](RenderContext&, const CancelToken&) {
+    gate.wait();
+    return ok();
+  };
+  Captured running, queued, refused;
+  pool.submit(blocked, running.reply());
+  // Wait until the worker has taken the first job, so the second one is the one waiting.
+  for (int i = 0; i < 500 && pool.snapshot().busyWorkers == 0; ++i)
+    std::this_thread::sleep_for(2ms);
+  pool.submit(blocked, queued.reply());
+  pool.submit(blocked, refused.reply());
+
+  api::Answer answer = refused.wait(1s);
+  EXPECT_EQ(answer.status, 429);
+  EXPECT_EQ(errorCode(answer), "busy");
+  EXPECT_FALSE(headerOf(answer, "Retry-After").empty());
+  EXPECT_EQ(pool.snapshot().queued, 1u);
+
+  gate.open();
+  EXPECT_EQ(running.wait().status, 200);
+  EXPECT_EQ(queued.wait().status, 200);
+}
+
+TEST(WorkerPool, DeadlineAnswers504WhileTheWorkerIsStillBusyAndCancelsIt) {
+  WorkerPool pool(options(1, 4, 100ms));
+  std::atomic<bool> sawCancel{false};
+  std::atomic<bool> workReturned{false};
+  Captured captured;
+  auto start = std::chrono::steady_clock::now();
+  pool.submit(
+      [&](RenderContext&, const CancelToken& cancel) {
+        // A render that would run for 10 s unless it notices its token.
+        auto until = std::chrono::steady_clock::now() + 10s;
+        while (std::chrono::steady_clock::now() < until && !cancel.expired()) {
+          std::this_thread::sleep_for(1ms);
+        }
+        sawCancel = cancel.expired();
+        std::this_thread::sleep_for(200ms);  // still busy after the deadline
+        workReturned = true;
+        return ok();
+      },
+      captured.reply());
+  api::Answer answer = captured.wait(5s);
+  auto elapsed = std::chrono::steady_clock::now() - start;
+  EXPECT_EQ(answer.status, 504);
+  EXPECT_EQ(errorCode(answer), "timeout");
+  EXPECT_FALSE(workReturned) << "the 504 must not wait for the worker";
+  EXPECT_LT(elapsed, 2s);
+  for (int i = 0; i < 500 && !workReturned; ++i) std::this_thread::sleep_for(2ms);
+  EXPECT_TRUE(sawCancel);
+  EXPECT_EQ(captured.calls, 1) << "the worker's late answer must be dropped";
+}
+
+TEST(WorkerPool, JobsStillQueuedAtTheirDeadlineAreDroppedWith504) {
+  WorkerPool pool(options(1, 4, 100ms));
+  Gate gate;
+  std::atomic<bool> secondRan{false};
+  Captured first, second;
+  pool.submit(
+      [&gate](RenderContext&, const CancelToken&) {
+        gate.wait();
+        return ok();
+      },
+      first.reply());
+  pool.submit(
+      [&secondRan](RenderContext&, const CancelToken&) {
+        secondRan = true;
+        return ok();
+      },
+      second.reply());
+  EXPECT_EQ(second.wait(5s).status, 504);
+  EXPECT_EQ(pool.snapshot().queued, 0u);
+  gate.open();
+  EXPECT_EQ(first.wait().status, 504);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_FALSE(secondRan);
+}
+
+TEST(WorkerPool, StopAnswers503ToQueuedAndRunningJobsAndCancelsTheRunningOnes) {
+  WorkerPool pool(options(1, 4));
+  std::atomic<bool> runningCancelled{false};
+  Captured running, queued, late;
+  pool.submit(
+      [&](RenderContext&, const CancelToken& cancel) {
+        while (!cancel.expired()) std::this_thread::sleep_for(1ms);
+        runningCancelled = true;
+        return ok();
+      },
+      running.reply());
+  for (int i = 0; i < 500 && pool.snapshot().busyWorkers == 0; ++i)
+    std::this_thread::sleep_for(2ms);
+  pool.submit([](RenderContext&, const CancelToken&) { return ok(); }, queued.reply());
+
+  pool.stop();
+  EXPECT_EQ(running.wait(1s).status, 503);
+  api::Answer dropped = queued.wait(1s);
+  EXPECT_EQ(dropped.status, 503);
+  EXPECT_EQ(errorCode(dropped), "unavailable");
+  pool.submit([](RenderContext&, const CancelToken&) { return ok(); }, late.reply());
+  api::Answer refused = late.wait(1s);
+  EXPECT_EQ(refused.status, 503);
+  EXPECT_EQ(errorCode(refused), "unavailable");
+  pool.join();
+  EXPECT_TRUE(runningCancelled);
+}
+
+TEST(WorkerPool, AThrowingJobBecomes500) {
+  WorkerPool pool(options(1, 1));
+  Captured captured;
+  pool.submit(
+      [](RenderContext&, const CancelToken&) -> api::Answer { throw std::runtime_error("boom"); },
+      captured.reply());
+  api::Answer answer = captured.wait();
+  EXPECT_EQ(answer.status, 500);
+  EXPECT_EQ(errorCode(answer), "internal");
+}
+
+// ---- Router ----
+
+api::Answer route(Router& router, const std::string& method, const std::string& target,
+                  const std::string& body = "") {
+  Captured captured;
+  router.handle({method, target, body}, captured.reply());
+  return captured.wait(60s);
+}
+
+class RouterTest : public ::testing::Test {
+ protected:
+  WorkerPool pool{options(1, 2)};
+  Router router{render::pipeline::JobLimits{}, pool};
+};
+
+TEST_F(RouterTest, UnknownPathIs404Json) {
+  api::Answer answer = route(router, "GET", "/nope");
+  EXPECT_EQ(answer.status, 404);
+  EXPECT_EQ(answer.contentType, "application/json");
+  EXPECT_EQ(errorCode(answer), "not_found");
+}
+
+TEST_F(RouterTest, WrongMethodIs405WithAllow) {
+  api::Answer answer = route(router, "GET", "/v1/render");
+  EXPECT_EQ(answer.status, 405);
+  EXPECT_EQ(errorCode(answer), "method_not_allowed");
+  EXPECT_EQ(headerOf(answer, "Allow"), "POST");
+  EXPECT_EQ(headerOf(route(router, "DELETE", "/healthz"), "Allow"), "GET");
+}
+
+TEST_F(RouterTest, HealthzDescribesTheWorkers) {
+  api::Answer answer = route(router, "GET", "/healthz?verbose=1");
+  ASSERT_EQ(answer.status, 200);
+  rapidjson::Document doc;
+  doc.Parse(answer.body.c_str());
+  ASSERT_FALSE(doc.HasParseError()) << answer.body;
+  EXPECT_STREQ(doc["status"].GetString(), "ok");
+  EXPECT_EQ(doc["workers"].GetInt(), 1);
+  EXPECT_EQ(doc["queueCapacity"].GetInt(), 2);
+  EXPECT_EQ(doc["queueDepth"].GetInt(), 0);
+  EXPECT_GT(std::string(doc["renderer"].GetString()).size(), 0u);
+  EXPECT_TRUE(doc["version"].IsString());
+  EXPECT_TRUE(doc["uptimeS"].IsNumber());
+}
+
+TEST_F(RouterTest, ReadyzFollowsThePool) {
+  EXPECT_EQ(route(router, "GET", "/readyz").status, 200);
+  pool.stop();
+  api::Answer answer = route(router, "GET", "/readyz");
+  EXPECT_EQ(answer.status, 503);
+  EXPECT_NE(answer.body.find("\"ready\":false"), std::string::npos);
+}
+
+TEST_F(RouterTest, MetricsCountAnswersByRouteAndStatus) {
+  router.stats().record(Router::routeLabel("/healthz"), 200, 0.5);
+  router.stats().record(Router::routeLabel("/healthz"), 200, 0.25);
+  router.stats().record(Router::routeLabel("/wp-admin.php"), 404, 0.001);
+  api::Answer answer = route(router, "GET", "/metrics");
+  ASSERT_EQ(answer.status, 200);
+  EXPECT_EQ(answer.contentType.rfind("text/plain", 0), 0u);
+  const std::string& text = answer.body;
+  EXPECT_NE(text.find("limn_requests_total{path=\"/healthz\",status=\"200\"} 2\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("limn_requests_total{path=\"other\",status=\"404\"} 1\n"), std::string::npos);
+  EXPECT_NE(text.find("limn_request_duration_seconds_sum{path=\"/healthz\"} 0.75\n"),
+            std::string::npos);
+  EXPECT_NE(text.find("limn_request_duration_seconds_count{path=\"/healthz\"} 2\n"),
+            std::string::npos);
+  EXPECT_NE(text.find("limn_queue_depth 0\n"), std::string::npos);
+  EXPECT_NE(text.find("limn_workers_busy 0\n"), std::string::npos);
+  EXPECT_EQ(text.find("wp-admin"), std::string::npos) << "unknown paths are folded into other";
+}
+
+TEST_F(RouterTest, OpenApiIsServed) {
+  api::Answer answer = route(router, "GET", "/openapi.json");
+  ASSERT_EQ(answer.status, 200);
+  rapidjson::Document doc;
+  doc.Parse(answer.body.c_str());
+  ASSERT_FALSE(doc.HasParseError());
+  EXPECT_TRUE(doc.HasMember("openapi"));
+}
+
+TEST_F(RouterTest, RenderRunsOnTheWorkerPool) {
+  const std::string body = R"({
+    "mesh": {"format": "obj", "data": "v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n"},
+    "camera": {"width": 32, "height": 32},
+    "method": "coarse",
+    "outputs": ["color"]
+  })";
+  api::Answer answer = route(router, "POST", "/v1/render", body);
+  EXPECT_EQ(answer.status, 200) << answer.body.substr(0, 300);
+  EXPECT_EQ(pool.snapshot().renderCount, 1u);
+
+  api::Answer bad = route(router, "POST", "/v1/render", "{not json");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_EQ(errorCode(bad), "invalid_json");
+}
+
+}  // namespace
+}  // namespace limn::server
