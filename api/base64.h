@@ -16,7 +16,8 @@ inline std::string encodeBase64(std::string_view text) {
   return encodeBase64(reinterpret_cast<const unsigned char*>(text.data()), text.size());
 }
 
-// The bytes, or nothing when `text` is not canonical padded base64 (for tests and clients).
+// The bytes, or nothing when `text` is not padded base64 of the standard alphabet (for tests
+// and tools).
 std::optional<std::vector<unsigned char>> decodeBase64(std::string_view text);
 
 }  // namespace limn::api

@@ -1,10 +1,11 @@
 #include "api/obj_scan.h"
 
-#include <cerrno>
+#include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <set>
+#include <system_error>
 
 #include "api/json_util.h"
 #include "render/core/error.h"
@@ -28,8 +29,9 @@ constexpr int kMaxObjFaceSize = 255;
                    "line " + std::to_string(line) + ": " + message + ": exceeds limit " + limit);
 }
 
-std::vector<std::string_view> tokenize(std::string_view line) {
-  std::vector<std::string_view> tokens;
+// Splits on spaces and tabs into `tokens` (reused across lines: no allocation per line).
+void tokenize(std::string_view line, std::vector<std::string_view>& tokens) {
+  tokens.clear();
   size_t i = 0;
   while (i < line.size()) {
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
@@ -37,7 +39,6 @@ std::vector<std::string_view> tokenize(std::string_view line) {
     while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
     if (i > start) tokens.push_back(line.substr(start, i - start));
   }
-  return tokens;
 }
 
 bool isDigit(char c) { return c >= '0' && c <= '9'; }
@@ -66,18 +67,24 @@ bool isDecimal(std::string_view t) {
 
 // A finite decimal number, or a syntax error that says what is wrong with `token`.
 double parseNumber(std::string_view token, int line, const char* what) {
-  std::string text(token);
-  char* end = nullptr;
-  double value = std::strtod(text.c_str(), &end);
-  bool whole = end == text.c_str() + text.size();
   if (isDecimal(token)) {
+    // from_chars takes no '+'; it reports overflow and underflow alike as out of range, so
+    // that rare case goes through strtod, which returns 0 on underflow and HUGE_VAL on overflow.
+    std::string_view digits = token[0] == '+' ? token.substr(1) : token;
+    double value = 0;
+    auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (error == std::errc() && end == digits.data() + digits.size()) return value;
+    value = std::strtod(std::string(token).c_str(), nullptr);
     if (!std::isfinite(value)) {
       syntax(line,
              std::string(what) + " " + json::quote(token) + " is not finite (overflows a double)");
     }
     return value;
   }
-  if (whole && !std::isfinite(value)) {
+  std::string text(token);
+  char* end = nullptr;
+  double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() + text.size() && !std::isfinite(value)) {
     syntax(line, std::string(what) + " " + json::quote(token) + " is not finite");
   }
   syntax(line, std::string(what) + " " + json::quote(token) + " is not a decimal number");
@@ -112,7 +119,8 @@ class Scanner {
   explicit Scanner(const render::mesh::MeshLimits& limits) : limits_(limits) {}
 
   void line(std::string_view text, int number) {
-    std::vector<std::string_view> tokens = tokenize(text);
+    tokenize(text, tokens_);
+    const std::vector<std::string_view>& tokens = tokens_;
     if (tokens.empty() || tokens[0][0] == '#') return;
     std::string_view keyword = tokens[0];
     if (keyword == "v") return vertex(tokens, number);
@@ -162,17 +170,23 @@ class Scanner {
     for (int k = 1; k <= n; ++k) {
       std::string_view token = tokens[k];
       // v, v/vt, v//vn or v/vt/vn: every index a non-zero integer, vt may be empty with vn.
-      std::vector<std::string_view> parts;
-      size_t start = 0;
-      for (size_t slash; (slash = token.find('/', start)) != std::string_view::npos;) {
-        parts.push_back(token.substr(start, slash - start));
+      std::string_view parts[3];
+      size_t count = 0, start = 0;
+      bool ok = true;
+      for (;;) {
+        size_t slash = token.find('/', start);
+        if (count == 3) {
+          ok = false;
+          break;
+        }
+        parts[count++] = token.substr(
+            start, slash == std::string_view::npos ? std::string_view::npos : slash - start);
+        if (slash == std::string_view::npos) break;
         start = slash + 1;
       }
-      parts.push_back(token.substr(start));
-      bool ok = parts.size() <= 3;
       int index = 0;
-      for (size_t p = 0; ok && p < parts.size(); ++p) {
-        if (p == 1 && parts.size() == 3 && parts[1].empty()) continue;  // v//vn
+      for (size_t p = 0; ok && p < count; ++p) {
+        if (p == 1 && count == 3 && parts[1].empty()) continue;  // v//vn
         int value = 0;
         ok = parseInt(parts[p], &value) && value != 0;
         if (p == 0) index = value;
@@ -241,6 +255,7 @@ class Scanner {
   }
 
   const render::mesh::MeshLimits& limits_;
+  std::vector<std::string_view> tokens_;
   ObjScan scan_;
   std::set<std::string> warned_;
 };
