@@ -26,6 +26,10 @@ struct ReferenceStats {
   size_t raysCast = 0;
   size_t newtonFailures = 0;   // hits whose refinement did not converge (kept unrefined)
   double tessellateMs = 0, bvhMs = 0, traceMs = 0;
+  size_t outlineFaces = 0;     // faces tessellated finely because they carry an outline
+  size_t hits = 0;             // output pixels covered
+  double newtonMs = 0;         // refinement and shading of the hits (traceMs: primary rays only)
+  double maskMs = 0;           // the supersampled mask's rays
 };
 
 struct ReferenceResult {
@@ -36,6 +40,13 @@ struct ReferenceResult {
 
 // `passes.supersample` > 0 also fills the supersampled mask. Uses all hardware threads through
 // TBB (Embree's), and checks `cancel` between rows of tiles.
+//
+// Passes follow the rasteriser's conventions: color RGBA (alpha 1 where covered; empty pixels
+// are shading::kBackground with alpha 0), mask 1/0, depth linear (0 = empty), normal the unit
+// limit normal as oriented by the face winding (not flipped towards the viewer; 0 = empty).
+// The wireframe pass of the reference is its color pass: the limit surface has no edges to draw
+// (a warning says so). Rays are clipped to the camera's [near, far] like the rasteriser's
+// triangles. The supersampled mask is the dense tessellation's coverage at camera.scaled(S).
 ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
                                 const PassSelection& passes, const CancelToken& cancel);
 

@@ -1,0 +1,190 @@
+#include "render/oracle/ray_caster.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <limits>
+
+#include "render/core/error.h"
+#include "render/oracle/embree_device.h"
+
+namespace limn::render::oracle {
+
+namespace {
+
+constexpr int kBlock = 4;  // packets cover kBlock x kBlock pixels
+
+// Runs body(y0, y1) over bands of kBlock rows on all threads, with FTZ/DAZ set and the cancel
+// token checked before every band.
+template <typename Body>
+void forEachBand(int height, const CancelToken& cancel, const Body& body) {
+  const int bands = (height + kBlock - 1) / kBlock;
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& r) {
+    FlushDenormalsScope ftz;
+    for (int band = r.begin(); band < r.end(); ++band) {
+      if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
+        cancelled = true;
+        return;
+      }
+      body(band * kBlock, std::min(height, (band + 1) * kBlock));
+    }
+  });
+  if (cancelled) throw Cancelled();
+}
+
+// Fills lane `k` of a ray packet (or a single ray through the same fields) with a pixel's ray.
+// Embree gets the ray from its near point on, so tnear is 0 and t is measured from there.
+template <typename RayN>
+void setLane(RayN& ray, int k, const PixelRay& r) {
+  Vec3 o = r.origin + r.direction * r.tNear;
+  ray.org_x[k] = static_cast<float>(o.x);
+  ray.org_y[k] = static_cast<float>(o.y);
+  ray.org_z[k] = static_cast<float>(o.z);
+  ray.dir_x[k] = static_cast<float>(r.direction.x);
+  ray.dir_y[k] = static_cast<float>(r.direction.y);
+  ray.dir_z[k] = static_cast<float>(r.direction.z);
+  ray.tnear[k] = 0.0f;
+  ray.tfar[k] = static_cast<float>(r.tFar - r.tNear);
+  ray.time[k] = 0.0f;
+  ray.mask[k] = 0xFFFFFFFFu;
+  ray.id[k] = static_cast<unsigned>(k);
+  ray.flags[k] = 0;
+}
+
+void setRay(RTCRay& ray, const PixelRay& r) {
+  Vec3 o = r.origin + r.direction * r.tNear;
+  ray.org_x = static_cast<float>(o.x);
+  ray.org_y = static_cast<float>(o.y);
+  ray.org_z = static_cast<float>(o.z);
+  ray.dir_x = static_cast<float>(r.direction.x);
+  ray.dir_y = static_cast<float>(r.direction.y);
+  ray.dir_z = static_cast<float>(r.direction.z);
+  ray.tnear = 0.0f;
+  ray.tfar = static_cast<float>(r.tFar - r.tNear);
+  ray.time = 0.0f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+}
+
+// Visits the 4 x 4 blocks of rows [y0, y1): fn(x0, y0, lanePixel) with lanePixel(k) giving the
+// pixel of lane k or false when the lane lies outside the image.
+struct Block {
+  int x0, y0, width, height;
+  bool pixel(int k, int& x, int& y) const {
+    x = x0 + k % kBlock;
+    y = y0 + k / kBlock;
+    return x < width && y < height;
+  }
+};
+
+}  // namespace
+
+PixelRay pixelRay(const Camera& camera, double px, double py) {
+  Ray ray = camera.rayThrough(px, py);
+  // Depth along the view is t * cos(angle to the forward axis): clip at near and far depth.
+  double cosine = dot(ray.direction, camera.forward());
+  PixelRay r{ray.origin, ray.direction, camera.nearPlane() / cosine,
+             camera.farPlane() / cosine};
+  if (camera.projection() == Projection::Perspective) r.tNear = std::max(r.tNear, 0.0);
+  return r;
+}
+
+std::vector<PixelHit> castClosestHits(RTCScene scene, const Camera& camera, RayPacking packing,
+                                      const CancelToken& cancel) {
+  const int width = camera.width(), height = camera.height();
+  std::vector<PixelHit> hits(static_cast<size_t>(width) * height);
+  forEachBand(height, cancel, [&](int y0, int y1) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (int x0 = 0; x0 < width; x0 += kBlock) {
+      Block block{x0, y0, width, y1};
+      PixelRay rays[kBlock * kBlock];
+      if (packing == RayPacking::Packet16) {
+        alignas(64) int valid[16];
+        alignas(64) RTCRayHit16 packet;
+        for (int k = 0; k < 16; ++k) {
+          int x, y;
+          valid[k] = block.pixel(k, x, y) ? -1 : 0;
+          rays[k] = pixelRay(camera, valid[k] ? x + 0.5 : x0 + 0.5, valid[k] ? y + 0.5 : y0 + 0.5);
+          setLane(packet.ray, k, rays[k]);
+          packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, scene, &context, &packet);
+        for (int k = 0; k < 16; ++k) {
+          int x, y;
+          if (!block.pixel(k, x, y) || packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+          PixelHit& h = hits[static_cast<size_t>(y) * width + x];
+          h.primID = packet.hit.primID[k];
+          h.u = packet.hit.u[k];
+          h.v = packet.hit.v[k];
+          h.t = rays[k].tNear + packet.ray.tfar[k];
+        }
+      } else {
+        for (int k = 0; k < 16; ++k) {
+          int x, y;
+          if (!block.pixel(k, x, y)) continue;
+          PixelRay r = pixelRay(camera, x + 0.5, y + 0.5);
+          RTCRayHit rayhit;
+          setRay(rayhit.ray, r);
+          rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(scene, &context, &rayhit);
+          if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          PixelHit& h = hits[static_cast<size_t>(y) * width + x];
+          h.primID = rayhit.hit.primID;
+          h.u = rayhit.hit.u;
+          h.v = rayhit.hit.v;
+          h.t = r.tNear + rayhit.ray.tfar;
+        }
+      }
+    }
+  });
+  return hits;
+}
+
+Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
+                   const CancelToken& cancel) {
+  const int width = camera.width(), height = camera.height();
+  Image mask(width, height, 1, 0.0f);
+  forEachBand(height, cancel, [&](int y0, int y1) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (int x0 = 0; x0 < width; x0 += kBlock) {
+      Block block{x0, y0, width, y1};
+      if (packing == RayPacking::Packet16) {
+        alignas(64) int valid[16];
+        alignas(64) RTCRay16 packet;
+        for (int k = 0; k < 16; ++k) {
+          int x, y;
+          valid[k] = block.pixel(k, x, y) ? -1 : 0;
+          setLane(packet, k,
+                  pixelRay(camera, valid[k] ? x + 0.5 : x0 + 0.5, valid[k] ? y + 0.5 : y0 + 0.5));
+        }
+        rtcOccluded16(valid, scene, &context, &packet);
+        for (int k = 0; k < 16; ++k) {
+          int x, y;
+          // An occlusion ray that hit something comes back with tfar = -inf.
+          if (block.pixel(k, x, y) && packet.tfar[k] < 0.0f) mask.at(x, y) = 1.0f;
+        }
+      } else {
+        for (int k = 0; k < 16; ++k) {
+          int x, y;
+          if (!block.pixel(k, x, y)) continue;
+          RTCRay ray;
+          setRay(ray, pixelRay(camera, x + 0.5, y + 0.5));
+          rtcOccluded1(scene, &context, &ray);
+          if (ray.tfar < 0.0f) mask.at(x, y) = 1.0f;
+        }
+      }
+    }
+  });
+  return mask;
+}
+
+}  // namespace limn::render::oracle

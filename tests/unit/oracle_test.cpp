@@ -1,0 +1,556 @@
+// The reference (dense tessellation + Embree + Newton onto the limit surface) and its
+// independent cross-check (Embree's own Catmull-Clark subdivision geometry): exactness at known
+// points, the outline against the limit surface's own silhouette, agreement of the two paths
+// and across supersampling factors, refusal of what Embree cannot represent.
+#include "render/oracle/reference.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "render/core/error.h"
+#include "render/core/shading.h"
+#include "render/metrics/metrics.h"
+#include "render/oracle/embree_device.h"
+#include "render/oracle/ray_caster.h"
+#include "render/oracle/reference_tessellation.h"
+#include "render/oracle/triangle_scene.h"
+#include "tests/unit/test_meshes.h"
+
+namespace limn::render::oracle {
+namespace {
+
+using mesh::ControlMesh;
+
+// The standard test view: the bounds' centre seen from +Z (or from centre + `offset`), square
+// image of `size`.
+Camera viewOf(const subdiv::LimitSurface& surface, int size, Vec3 offset = {0, 0, 0},
+              Projection projection = Projection::Perspective) {
+  CameraSpec spec;
+  spec.width = size;
+  spec.height = size;
+  spec.projection = projection;
+  if (length(offset) > 0) spec.eye = surface.bounds().center() + offset;
+  return resolveCamera(spec, surface.bounds());
+}
+
+PassSelection allPasses(int supersample) {
+  return PassSelection{.color = true, .mask = true, .depth = true, .normal = true,
+                       .wireframe = false, .supersample = supersample};
+}
+
+double coverage(const Image& mask) {
+  double sum = 0;
+  for (float v : mask.pixels) sum += v;
+  return sum;
+}
+
+// Outline length of a mask in its own pixels (4-neighbour transitions), for turning an area
+// difference into a mean displacement of the outline.
+double outlineLength(const Image& mask) {
+  double edges = 0;
+  for (int y = 0; y < mask.height; ++y) {
+    for (int x = 0; x < mask.width; ++x) {
+      bool c = mask.at(x, y) > 0.5f;
+      if (x + 1 < mask.width && c != (mask.at(x + 1, y) > 0.5f)) ++edges;
+      if (y + 1 < mask.height && c != (mask.at(x, y + 1) > 0.5f)) ++edges;
+    }
+  }
+  return edges * std::numbers::pi / 4;  // staircase length -> curve length, on average
+}
+
+// Mean displacement between two masks' outlines in output pixels: area difference / length.
+double meanOutlineShiftPx(const Image& a, int sa, const Image& b, int sb) {
+  double areaA = coverage(a) / (sa * sa), areaB = coverage(b) / (sb * sb);
+  double lengthA = outlineLength(a) / sa;
+  return std::fabs(areaA - areaB) / std::max(lengthA, 1.0);
+}
+
+// Face of the mesh whose vertices all have coordinate `axis` equal to `value`.
+int faceWhere(const ControlMesh& m, int axis, double value) {
+  size_t offset = 0;
+  for (int f = 0; f < m.faceCount(); ++f) {
+    bool all = true;
+    for (int k = 0; k < m.faceVertexCounts[f]; ++k) {
+      all = all && std::fabs(m.points[m.faceVertexIndices[offset + k]][axis] - value) < 1e-12;
+    }
+    if (all) return f;
+    offset += m.faceVertexCounts[f];
+  }
+  return -1;
+}
+
+// ---- A minimal reader for the corpus's OBJ files (v, f and the t tags). ----
+
+std::optional<ControlMesh> readCorpusObj(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  ControlMesh m;
+  std::string name = path.filename().string();
+  if (name.rfind("loop_", 0) == 0) m.scheme = mesh::Scheme::Loop;
+  if (name.rfind("bilinear_", 0) == 0) m.scheme = mesh::Scheme::Bilinear;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string kind;
+    s >> kind;
+    if (kind == "v") {
+      Vec3 p;
+      s >> p.x >> p.y >> p.z;
+      m.points.push_back(p);
+    } else if (kind == "f") {
+      std::string token;
+      int count = 0;
+      while (s >> token) {
+        m.faceVertexIndices.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
+        ++count;
+      }
+      m.faceVertexCounts.push_back(count);
+    } else if (kind == "t") {
+      std::string tag, sizes;
+      s >> tag >> sizes;
+      int ni = 0, nf = 0, ns = 0;
+      std::sscanf(sizes.c_str(), "%d/%d/%d", &ni, &nf, &ns);
+      std::vector<int> ints(ni);
+      std::vector<float> floats(nf);
+      std::vector<std::string> strings(ns);
+      for (int& i : ints) s >> i;
+      for (float& f : floats) s >> f;
+      for (std::string& str : strings) s >> str;
+      if (tag == "crease") {
+        for (int k = 0; k + 1 < ni; k += 2) {
+          m.creases.push_back({ints[k], ints[k + 1], floats[nf == 1 ? 0 : k / 2]});
+        }
+      } else if (tag == "corner") {
+        for (int k = 0; k < ni; ++k) m.corners.push_back({ints[k], floats[nf == 1 ? 0 : k]});
+      } else if (tag == "hole") {
+        m.holes.insert(m.holes.end(), ints.begin(), ints.end());
+      } else if (tag == "interpolateboundary") {
+        m.boundary = ints[0] == 0   ? mesh::BoundaryInterpolation::None
+                     : ints[0] == 1 ? mesh::BoundaryInterpolation::EdgeAndCorner
+                                    : mesh::BoundaryInterpolation::EdgeOnly;
+      } else if (tag == "creasemethod" && !strings.empty() && strings[0] == "chaikin") {
+        m.creaseMethod = mesh::CreaseMethod::Chaikin;
+      } else if (tag == "smoothtriangles" && !strings.empty() && strings[0] == "smooth") {
+        m.triangleSubdivision = mesh::TriangleSubdivision::Smooth;
+      }
+    }
+  }
+  return m;
+}
+
+std::filesystem::path corpusDir() {
+  return std::filesystem::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
+}
+
+// ---- The reference at known points ----
+
+TEST(Reference, CubeCentrePixelIsTheFaceCentreExactly) {
+  ControlMesh m = testing::cube();
+  subdiv::LimitSurface surface(m);
+  for (Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    Camera camera = viewOf(surface, 129, {0, 0, 0}, projection);  // odd: a pixel at the centre
+    ReferenceResult r = renderReference(surface, camera, allPasses(0), CancelToken());
+    int front = faceWhere(m, 2, 0.5);
+    ASSERT_GE(front, 0);
+    Vec2 c = surface.centerUV(front);
+    subdiv::LimitSample s = surface.evaluate(front, c.x, c.y);
+
+    const Image& depth = r.images.passes.at(pass::kDepth);
+    const Image& normal = r.images.passes.at(pass::kNormal);
+    double expected = camera.depthOf(s.position);
+    EXPECT_NEAR(depth.at(64, 64), expected, 1e-6 * expected);
+    EXPECT_NEAR(normal.at(64, 64, 0), s.normal.x, 1e-6);
+    EXPECT_NEAR(normal.at(64, 64, 1), s.normal.y, 1e-6);
+    EXPECT_NEAR(normal.at(64, 64, 2), s.normal.z, 1e-6);
+    EXPECT_NEAR(s.normal.z, 1.0, 1e-12);
+
+    // Shading of that point: the headlight sees the normal head on.
+    float rgb[3];
+    shading::shade(s.normal, Vec3{0, 0, 1}, rgb);
+    const Image& color = r.images.passes.at(pass::kColor);
+    for (int c3 = 0; c3 < 3; ++c3) EXPECT_NEAR(color.at(64, 64, c3), rgb[c3], 1e-6);
+    EXPECT_EQ(color.at(64, 64, 3), 1.0f);
+    // Corners are empty: background colour, alpha 0, depth and normal 0.
+    EXPECT_EQ(color.at(0, 0, 3), 0.0f);
+    EXPECT_NEAR(color.at(0, 0, 0), shading::kBackground[0], 1e-7);
+    EXPECT_EQ(depth.at(0, 0), 0.0f);
+    EXPECT_EQ(normal.at(0, 0, 2), 0.0f);
+    EXPECT_EQ(r.images.passes.at(pass::kMask).at(0, 0), 0.0f);
+    EXPECT_EQ(r.images.passes.at(pass::kMask).at(64, 64), 1.0f);
+  }
+}
+
+// A uniform cubic B-spline reproduces quadratics: control points on z = a x^2 give the limit
+// surface z = a (x^2 + c) over the regular interior faces, a parabolic cylinder whose ray
+// intersections are known in closed form. Depth and normal of every pixel that sees that part
+// must match them to float precision: the refinement really lands on the limit surface.
+TEST(Reference, DepthAndNormalsMatchAnAnalyticLimitSurface) {
+  const int n = 8;
+  const double a = 0.8, h = 1.0 / n;
+  ControlMesh m = testing::grid(n, 0.0);
+  for (Vec3& p : m.points) p.z = a * p.x * p.x;
+  subdiv::LimitSurface surface(m);
+  Vec2 c4 = surface.centerUV(4 * n + 3);  // an interior face: find c from one limit point
+  Vec3 q = surface.position(4 * n + 3, c4.x, c4.y);
+  const double c = q.z / a - q.x * q.x;
+  EXPECT_NEAR(c, h * h / 3, 1e-12);  // the B-spline's known offset
+
+  for (Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    Camera camera = viewOf(surface, 120, {0.15, -0.35, 1.3}, projection);
+    ReferenceResult r = renderReference(surface, camera, allPasses(0), CancelToken());
+    const Image& depth = r.images.passes.at(pass::kDepth);
+    const Image& normal = r.images.passes.at(pass::kNormal);
+    int checked = 0;
+    for (int y = 0; y < camera.height(); ++y) {
+      for (int x = 0; x < camera.width(); ++x) {
+        if (depth.at(x, y) == 0) continue;
+        PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
+        const Vec3& o = ray.origin;
+        const Vec3& d = ray.direction;
+        // a (o.x + t d.x)^2 + a c - (o.z + t d.z) = 0, nearest root ahead.
+        double A = a * d.x * d.x, B = 2 * a * o.x * d.x - d.z, C = a * (o.x * o.x + c) - o.z;
+        double disc = std::sqrt(B * B - 4 * A * C);
+        double t1 = (-B - disc) / (2 * A), t2 = (-B + disc) / (2 * A);
+        double t = std::fabs(A) < 1e-15 ? -C / B : (t1 > ray.tNear ? t1 : t2);
+        Vec3 p = o + d * t;
+        if (std::max(std::fabs(p.x), std::fabs(p.y)) > 0.5 - 1.5 * h) continue;  // not regular
+        double expected = camera.depthOf(p);
+        ASSERT_NEAR(depth.at(x, y), expected, 2e-7 * expected) << x << " " << y;
+        Vec3 nn = normalize(Vec3{-2 * a * p.x, 0, 1});
+        ASSERT_NEAR(normal.at(x, y, 0), nn.x, 1e-6);
+        ASSERT_NEAR(normal.at(x, y, 1), nn.y, 1e-6);
+        ASSERT_NEAR(normal.at(x, y, 2), nn.z, 1e-6);
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 2000);
+    EXPECT_EQ(r.stats.newtonFailures, 0u);
+  }
+}
+
+// On a creased torus seen at an angle: covered pixels are exactly the mask, normals are unit,
+// and refinement fails (almost) nowhere.
+TEST(Reference, CreasedTorusRefinesEverywhere) {
+  subdiv::LimitSurface surface(testing::torus(12, 8, true));
+  Camera camera = viewOf(surface, 96, {1.5, -2.0, 3.5});
+  ReferenceResult r = renderReference(surface, camera, allPasses(0), CancelToken());
+  const Image& mask = r.images.passes.at(pass::kMask);
+  const Image& normal = r.images.passes.at(pass::kNormal);
+  ASSERT_GT(r.stats.hits, 1000u);
+  EXPECT_EQ(static_cast<size_t>(coverage(mask)), r.stats.hits);
+  for (int y = 0; y < mask.height; ++y) {
+    for (int x = 0; x < mask.width; ++x) {
+      if (mask.at(x, y) == 0) continue;
+      Vec3 nv{normal.at(x, y, 0), normal.at(x, y, 1), normal.at(x, y, 2)};
+      ASSERT_NEAR(length(nv), 1.0, 1e-6);
+    }
+  }
+  EXPECT_LE(r.stats.newtonFailures, r.stats.hits / 1000);
+}
+
+// The cube's outline on the middle row, found on the limit surface itself: the silhouette point
+// of the curve y = 0 maximises the projected x. Coverage of that row must end exactly there.
+TEST(Reference, CubeOutlineMatchesLimitSilhouette) {
+  ControlMesh m = testing::cube();
+  subdiv::LimitSurface surface(m);
+  const int size = 257, S = 8;
+  Camera camera = viewOf(surface, size);
+  ReferenceResult r = renderReference(surface, camera, allPasses(S), CancelToken());
+
+  // Sample the y = 0 section of the +X and +Z faces densely (by symmetry it is the parameter
+  // line through the face centre along which y stays 0) and refine the maximum.
+  double best = 0;
+  for (int face : {faceWhere(m, 0, 0.5), faceWhere(m, 2, 0.5)}) {
+    for (int dir = 0; dir < 2; ++dir) {
+      auto point = [&](double s) {
+        return dir == 0 ? surface.position(face, s, 0.5) : surface.position(face, 0.5, s);
+      };
+      if (std::fabs(point(0.1).y) > 1e-12) continue;  // not the y = 0 line
+      auto projectedX = [&](double s) { return camera.project(point(s)).x; };
+      double lo = 0, hi = 1;
+      for (int i = 0; i < 200; ++i) {  // golden-section on a unimodal section
+        double a = hi - (hi - lo) * 0.618033988749895, b = lo + (hi - lo) * 0.618033988749895;
+        if (projectedX(a) < projectedX(b)) lo = a; else hi = b;
+      }
+      best = std::max(best, projectedX(0.5 * (lo + hi)));
+    }
+  }
+  ASSERT_GT(best, size * 0.5 + 10);
+
+  // The middle row (its pixel centres are on y = 0 since the size is odd) is covered for pixel
+  // centres within the half-width of the centre: 2 * floor(h + 1/2) centres at offsets k + 1/2
+  // (k >= 0) for an even row width, 2 * floor(h) + 1 at offsets k for an odd one. A count may be
+  // off by one crossing only when the outline passes within 0.02 px of a pixel centre.
+  auto expectRow = [](int counted, double expected, double fraction, const char* what) {
+    bool marginal = std::fabs(fraction - 0.5) > 0.48;
+    EXPECT_NEAR(counted, expected, marginal ? 2.0 : 0.0) << what << " fraction " << fraction;
+  };
+  const Image& mask = r.images.passes.at(pass::kMask);
+  int row = size / 2, covered = 0;
+  for (int x = 0; x < size; ++x) covered += mask.at(x, row) > 0.5f;
+  double halfWidth = best - 0.5 * size;
+  expectRow(covered, 2 * std::floor(halfWidth) + 1, halfWidth - std::floor(halfWidth), "output");
+
+  // At S = 8 the row S * row + S / 2 is half a supersampled pixel off y = 0, where the outline
+  // is vertical to far better than that; its pixel centres sit at offsets k + 1/2.
+  const Image& fine = r.images.supersampledMask;
+  ASSERT_EQ(fine.width, size * S);
+  int fineCovered = 0;
+  for (int x = 0; x < fine.width; ++x) fineCovered += fine.at(x, S * row + S / 2) > 0.5f;
+  double fineHalf = halfWidth * S + 0.5;
+  expectRow(fineCovered, 2 * std::floor(fineHalf), fineHalf - std::floor(fineHalf), "S = 8");
+}
+
+TEST(Reference, CubeMaskIsSymmetric) {
+  subdiv::LimitSurface surface(testing::cube());
+  const int size = 201, S = 4;
+  Camera camera = viewOf(surface, size);
+  ReferenceResult r = renderReference(surface, camera, allPasses(S), CancelToken());
+  for (const Image* mask : {&r.images.passes.at(pass::kMask), &r.images.supersampledMask}) {
+    int asymmetric = 0, covered = 0;
+    for (int y = 0; y < mask->height; ++y) {
+      for (int x = 0; x < mask->width; ++x) {
+        bool c = mask->at(x, y) > 0.5f;
+        covered += c;
+        asymmetric += c != (mask->at(mask->width - 1 - x, y) > 0.5f);
+        asymmetric += c != (mask->at(x, mask->height - 1 - y) > 0.5f);
+        asymmetric += c != (mask->at(y, x) > 0.5f);  // the cube seen from +Z is square
+      }
+    }
+    EXPECT_GT(covered, mask->width * mask->height / 10);
+    // Only pixel centres within float rounding of the outline may differ.
+    EXPECT_LE(asymmetric, mask->width / 50) << mask->width;
+  }
+}
+
+TEST(Reference, SupersampleFactorsAgree) {
+  subdiv::LimitSurface surface(testing::torus(12, 8, true));
+  Camera camera = viewOf(surface, 160, {0.8, -1.5, 3.0});
+  PassSelection maskOnly{.supersample = 4};
+  ReferenceResult r4 = renderReference(surface, camera, maskOnly, CancelToken());
+  maskOnly.supersample = 8;
+  ReferenceResult r8 = renderReference(surface, camera, maskOnly, CancelToken());
+  EXPECT_TRUE(r4.images.passes.empty());
+  EXPECT_EQ(r8.images.supersample, 8);
+  ASSERT_EQ(r8.images.supersampledMask.width, 160 * 8);
+  EXPECT_LT(meanOutlineShiftPx(r4.images.supersampledMask, 4, r8.images.supersampledMask, 8),
+            0.02);
+  // Upsample S = 4 to S = 8 (each pixel to 2 x 2): the outlines are within the quantisation of
+  // the coarser mask (a quarter pixel) plus the half-pixel offset of sample positions.
+  Image up(160 * 8, 160 * 8, 1);
+  for (int y = 0; y < up.height; ++y) {
+    for (int x = 0; x < up.width; ++x) up.at(x, y) = r4.images.supersampledMask.at(x / 2, y / 2);
+  }
+  metrics::SilhouetteMetrics sm = metrics::compareSilhouettes(up, r8.images.supersampledMask, 8);
+  EXPECT_LE(sm.hausdorffPx, 0.25 + 1e-9);
+  EXPECT_LT(sm.meanPx, 0.1);
+}
+
+// ---- The two reference paths agree ----
+
+void expectPathsAgree(const ControlMesh& m, Vec3 eye, int size, int S, const std::string& what) {
+  subdiv::LimitSurface surface(m);
+  Camera camera = viewOf(surface, size, eye);
+  ReferenceResult r = renderReference(surface, camera, PassSelection{.supersample = S}, {});
+  std::string whyNot;
+  std::optional<Image> embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot);
+  ASSERT_TRUE(embree) << what << ": " << whyNot;
+  ASSERT_GT(coverage(*embree), 0) << what;
+  metrics::SilhouetteMetrics sm =
+      metrics::compareSilhouettes(*embree, r.images.supersampledMask, S);
+  double shift = meanOutlineShiftPx(*embree, S, r.images.supersampledMask, S);
+  // Both outlines are within a small fraction of a supersampled pixel of the limit silhouette,
+  // so they may differ only at pixel centres that lie that close to it: one supersampled pixel,
+  // or two next to an infinitely sharp corner, whose tip Embree's grid cuts short.
+  EXPECT_LE(sm.hausdorffPx, std::sqrt(5.0) / S + 1e-9) << what;
+  EXPECT_LT(sm.meanPx, 0.01) << what;
+  EXPECT_LT(shift, 0.005) << what;
+  std::cout << "[ paths    ] " << what << ": hausdorff " << sm.hausdorffPx << " px, mean "
+            << sm.meanPx << " px, area shift " << shift << " px, triangles " << r.stats.triangles
+            << "\n";
+}
+
+TEST(CrossCheck, CubeAgrees) { expectPathsAgree(testing::cube(), {0.9, 1.1, 2.2}, 160, 4, "cube"); }
+
+TEST(CrossCheck, CubeWithCreasesAndCornerAgrees) {
+  ControlMesh m = testing::cube();
+  m.creases = {{0, 1, 10.0f}, {2, 4, 2.0f}};
+  m.corners = {{7, 10.0f}};
+  expectPathsAgree(m, {0.9, 1.1, 2.2}, 160, 4, "creased cube");
+}
+
+TEST(CrossCheck, TorusWithCreasesAgrees) {
+  // One ring of infinitely sharp edges, one loop of semi-sharp ones (they may not meet: Embree's
+  // rule for mixed sharpness at a vertex differs).
+  ControlMesh inf = testing::torus(12, 8, true), semi = inf;
+  inf.creases.resize(12);
+  semi.creases.erase(semi.creases.begin(), semi.creases.begin() + 12);
+  expectPathsAgree(inf, {0.5, -1.8, 2.6}, 160, 4, "torus, sharp ring");
+  expectPathsAgree(semi, {0.5, -1.8, 2.6}, 160, 4, "torus, semi-sharp loop");
+}
+
+TEST(CrossCheck, OpenGridAgrees) {
+  ControlMesh m = testing::grid(6, 0.3);
+  expectPathsAgree(m, {0.3, -0.9, 1.4}, 160, 4, "grid, edge-only");
+  m.boundary = mesh::BoundaryInterpolation::EdgeAndCorner;
+  expectPathsAgree(m, {0.3, -0.9, 1.4}, 160, 4, "grid, edge-and-corner");
+  m.holes = {14};
+  expectPathsAgree(m, {0.3, -0.9, 1.4}, 160, 4, "grid with a hole");
+}
+
+TEST(CrossCheck, RefusesWhatEmbreeCannotRepresent) {
+  std::string whyNot;
+  subdiv::LimitSurface loop(testing::icosahedron(mesh::Scheme::Loop));
+  Camera camera = viewOf(loop, 64);
+  EXPECT_FALSE(embreeSubdivisionMask(loop, camera, {}, &whyNot));
+  EXPECT_NE(whyNot.find("Catmull-Clark"), std::string::npos) << whyNot;
+
+  subdiv::LimitSurface bilinear(testing::cube(mesh::Scheme::Bilinear));
+  EXPECT_FALSE(embreeSubdivisionMask(bilinear, camera, {}, &whyNot));
+
+  ControlMesh chaikin = testing::cube();
+  chaikin.creaseMethod = mesh::CreaseMethod::Chaikin;
+  chaikin.creases = {{0, 1, 1.5f}};
+  subdiv::LimitSurface chaikinSurface(chaikin);
+  EXPECT_FALSE(embreeSubdivisionMask(chaikinSurface, camera, {}, &whyNot));
+  EXPECT_NE(whyNot.find("Chaikin"), std::string::npos) << whyNot;
+  chaikin.creases = {{0, 1, 10.0f}};  // infinitely sharp: the crease method does not matter
+  subdiv::LimitSurface sharpChaikin(chaikin);
+  EXPECT_TRUE(embreeSubdivisionMask(sharpChaikin, camera, {}, &whyNot)) << whyNot;
+
+  // Where Embree's crease rules differ from OpenSubdiv's: creases of different sharpness at a
+  // vertex, semi-sharp corners.
+  ControlMesh mixed = testing::cube();
+  mixed.creases = {{0, 1, 10.0f}, {1, 3, 2.5f}};
+  subdiv::LimitSurface mixedSurface(mixed);
+  EXPECT_FALSE(embreeSubdivisionMask(mixedSurface, camera, {}, &whyNot));
+  EXPECT_NE(whyNot.find("vertex 1"), std::string::npos) << whyNot;
+  ControlMesh semiCorner = testing::cube();
+  semiCorner.corners = {{7, 2.5f}};
+  subdiv::LimitSurface semiCornerSurface(semiCorner);
+  EXPECT_FALSE(embreeSubdivisionMask(semiCornerSurface, camera, {}, &whyNot));
+  EXPECT_NE(whyNot.find("corner"), std::string::npos) << whyNot;
+
+  ControlMesh smoothTris = testing::octahedron();
+  smoothTris.triangleSubdivision = mesh::TriangleSubdivision::Smooth;
+  subdiv::LimitSurface smoothTriSurface(smoothTris);
+  EXPECT_FALSE(embreeSubdivisionMask(smoothTriSurface, camera, {}, &whyNot));
+  EXPECT_NE(whyNot.find("triangle"), std::string::npos) << whyNot;
+
+  // Three faces on one edge.
+  ControlMesh fin;
+  fin.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {1, 0, 1}, {0, 0, 1}, {1, -1, 0},
+                {0, -1, 0}};
+  testing::addFace(fin, {0, 1, 2, 3});
+  testing::addFace(fin, {1, 0, 5, 4});
+  testing::addFace(fin, {0, 1, 6, 7});
+  subdiv::LimitSurface finSurface(fin);
+  EXPECT_FALSE(embreeSubdivisionMask(finSurface, camera, {}, &whyNot));
+  EXPECT_NE(whyNot.find("non-manifold"), std::string::npos) << whyNot;
+}
+
+// ---- Faces of other sizes, cancellation ----
+
+TEST(Reference, NgonsAndTrianglesRefineWithoutFailures) {
+  // The octahedron (triangles, Catmull-Clark) and a prism with pentagon caps: Bfr splits them
+  // into quad sub-faces, and Newton crosses between sub-faces.
+  ControlMesh prism;
+  for (int k = 0; k < 5; ++k) {
+    double a = 2 * std::numbers::pi * k / 5;
+    prism.points.push_back({std::cos(a), std::sin(a), 0.6});
+  }
+  for (int k = 0; k < 5; ++k) {
+    double a = 2 * std::numbers::pi * k / 5;
+    prism.points.push_back({std::cos(a), std::sin(a), -0.6});
+  }
+  testing::addFace(prism, {0, 1, 2, 3, 4});
+  testing::addFace(prism, {9, 8, 7, 6, 5});
+  for (int k = 0; k < 5; ++k) testing::addFace(prism, {k, k + 5, (k + 1) % 5 + 5, (k + 1) % 5});
+  for (const ControlMesh& m : {testing::octahedron(), prism}) {
+    subdiv::LimitSurface surface(m);
+    Camera camera = viewOf(surface, 128, {0.7, 0.9, 2.5});
+    ReferenceResult r = renderReference(surface, camera, allPasses(0), {});
+    EXPECT_GT(r.stats.hits, 3000u);
+    EXPECT_LE(r.stats.newtonFailures, r.stats.hits / 1000) << r.stats.newtonFailures;
+  }
+}
+
+TEST(Reference, HoleLetsRaysThrough) {
+  ControlMesh m = testing::grid(5, 0.0);
+  m.holes = {12};  // the centre face
+  subdiv::LimitSurface surface(m);
+  Camera camera = viewOf(surface, 101, {0, 0, 2});
+  ReferenceResult r = renderReference(surface, camera, allPasses(2), {});
+  const Image& mask = r.images.passes.at(pass::kMask);
+  EXPECT_EQ(mask.at(50, 50), 0.0f);
+  EXPECT_EQ(mask.at(50, 30), 1.0f);
+  EXPECT_EQ(r.images.supersampledMask.at(101, 101), 0.0f);
+}
+
+TEST(Reference, WireframePassIsTheColourWithAWarning) {
+  subdiv::LimitSurface surface(testing::cube());
+  Camera camera = viewOf(surface, 48);
+  ReferenceResult r = renderReference(surface, camera, PassSelection{.wireframe = true}, {});
+  ASSERT_TRUE(r.images.find(pass::kWireframe));
+  EXPECT_FALSE(r.images.find(pass::kColor));
+  EXPECT_EQ(r.images.find(pass::kWireframe)->channels, 4);
+  EXPECT_FALSE(r.warnings.empty());
+}
+
+TEST(Reference, CancelledTokenStopsTheJob) {
+  subdiv::LimitSurface surface(testing::cube());
+  Camera camera = viewOf(surface, 256);
+  CancelToken cancel;
+  cancel.cancel();
+  EXPECT_THROW(renderReference(surface, camera, allPasses(4), cancel), Cancelled);
+  EXPECT_THROW(embreeSubdivisionMask(surface, camera, cancel, nullptr), Cancelled);
+}
+
+// ---- The corpus, where present ----
+
+TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
+  std::filesystem::path dir = corpusDir();
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no corpus at " << dir;
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    std::string name = entry.path().filename().string();
+    if (name.rfind("catmark_", 0) != 0 || entry.path().extension() != ".obj") continue;
+    std::optional<ControlMesh> m = readCorpusObj(entry.path());
+    ASSERT_TRUE(m) << name;
+    std::unique_ptr<subdiv::LimitSurface> surface;
+    try {
+      mesh::validateMesh(*m, mesh::MeshLimits{});
+      surface = std::make_unique<subdiv::LimitSurface>(*m);
+    } catch (const InputError& e) {
+      continue;  // meshes OpenSubdiv refuses are the api's concern
+    }
+    const int size = 128, S = 4;
+    Camera camera = viewOf(*surface, size, Vec3{0.3, 0.45, 0.85} * surface->bounds().diagonal());
+    std::string whyNot;
+    std::optional<Image> embree = embreeSubdivisionMask(*surface, camera.scaled(S), {}, &whyNot);
+    if (!embree) {
+      std::cout << "[ corpus   ] " << name << ": no cross-check: " << whyNot << "\n";
+      continue;
+    }
+    ReferenceResult r = renderReference(*surface, camera, allPasses(S), {});
+    metrics::SilhouetteMetrics sm =
+        metrics::compareSilhouettes(*embree, r.images.supersampledMask, S);
+    std::cout << "[ corpus   ] " << name << ": hausdorff " << sm.hausdorffPx << " px, mean "
+              << sm.meanPx << " px, triangles " << r.stats.triangles << ", newton failures "
+              << r.stats.newtonFailures << "/" << r.stats.hits << "\n";
+    EXPECT_LE(sm.hausdorffPx, std::sqrt(5.0) / S + 1e-9) << name;
+    EXPECT_LT(sm.meanPx, 0.01) << name;
+    EXPECT_LE(r.stats.newtonFailures, r.stats.hits / 200 + 2) << name;
+    ++compared;
+  }
+  EXPECT_GT(compared, 10);
+}
+
+}  // namespace
+}  // namespace limn::render::oracle
