@@ -17,9 +17,7 @@
 #include "api/openapi.h"
 #include "api/render_api.h"
 
-#ifdef LIMN_API_HAVE_PIPELINE
 #include "render/raster/rasterizer.h"
-#endif
 
 namespace {
 
@@ -850,9 +848,7 @@ TEST(RenderRequest, ObjWarningsReachTheRequest) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Response writing (needs the image encoder)
-
-#ifdef LIMN_API_HAVE_IMAGE
+// Response writing
 
 render::pipeline::RenderResult handMadeResult() {
   render::Camera camera({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 35, render::Projection::Perspective, 2.5,
@@ -988,12 +984,8 @@ TEST(RenderResponse, OmitsReferenceWhenNotAskedAndWarnsOnMissingImages) {
   EXPECT_FLOAT_EQ(exr.at(0, 0, 0), 0.5f);
 }
 
-#endif  // LIMN_API_HAVE_IMAGE
-
 // ---------------------------------------------------------------------------------------------
-// handleRender (needs the pipeline)
-
-#ifdef LIMN_API_HAVE_PIPELINE
+// handleRender
 
 rapidjson::Document parseBody(const api::Answer& answer) {
   rapidjson::Document doc;
@@ -1056,8 +1048,6 @@ TEST(HandleRender, RendersTheCubeEndToEnd) {
   EXPECT_GT(mask.at(32, 24), 0.5f);  // the cube covers the centre
   EXPECT_LT(mask.at(0, 0), 0.5f);    // and not the corner
 }
-
-#endif  // LIMN_API_HAVE_PIPELINE
 
 // ---------------------------------------------------------------------------------------------
 // Configuration
