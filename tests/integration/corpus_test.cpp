@@ -1,0 +1,253 @@
+// Accuracy through the real server: every method on the project's own meshes and on every
+// shape of ../shared/corpus/osd-shapes (skipped when that folder does not exist), measured
+// against the Embree reference exactly as a client would see it.
+#include <gtest/gtest.h>
+#include <rapidjson/document.h>
+#include <rapidjson/stringbuffer.h>
+#include <rapidjson/writer.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "tests/integration/http_client.h"
+#include "tests/integration/server_process.h"
+
+namespace limn::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kCorpus = fs::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string schemeOf(const std::string& name) {
+  if (name.rfind("loop_", 0) == 0) return "loop";
+  if (name.rfind("bilinear_", 0) == 0) return "bilinear";
+  return "catmull-clark";
+}
+
+std::vector<std::string> corpusShapes() {
+  std::vector<std::string> names;
+  if (!fs::exists(kCorpus)) return names;
+  for (const auto& entry : fs::directory_iterator(kCorpus)) {
+    if (entry.path().extension() == ".obj") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// The project's own meshes, as OBJ text (with tags where they matter).
+std::map<std::string, std::pair<std::string, std::string>> ownMeshes() {  // name -> (scheme, obj)
+  std::map<std::string, std::pair<std::string, std::string>> meshes;
+  meshes["cube"] = {
+      "catmull-clark",
+      "v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\n"
+      "v 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n"};
+  meshes["tetrahedron"] = {"loop",
+                           "v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\n"
+                           "f 1 2 4\nf 1 3 2\nf 1 4 3\nf 2 3 4\n"};
+  meshes["octahedron"] = {
+      "catmull-clark",
+      "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+      "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n"};
+  // Torus 12 x 8 with one infinitely sharp ring and one semi-sharp tube loop.
+  {
+    std::ostringstream obj;
+    const int ring = 12, tube = 8;
+    for (int i = 0; i < ring; ++i) {
+      for (int j = 0; j < tube; ++j) {
+        double a = 2 * M_PI * i / ring, b = 2 * M_PI * j / tube;
+        obj << "v " << (1 + 0.35 * std::cos(b)) * std::cos(a) << " "
+            << (1 + 0.35 * std::cos(b)) * std::sin(a) << " " << 0.35 * std::sin(b) << "\n";
+      }
+    }
+    auto id = [&](int i, int j) { return (i % ring) * tube + (j % tube); };
+    for (int i = 0; i < ring; ++i) {
+      for (int j = 0; j < tube; ++j) {
+        obj << "f " << id(i, j) + 1 << " " << id(i + 1, j) + 1 << " " << id(i + 1, j + 1) + 1 << " "
+            << id(i, j + 1) + 1 << "\n";
+      }
+    }
+    for (int i = 0; i < ring; ++i)
+      obj << "t crease 2/1/0 " << id(i, 0) << " " << id(i + 1, 0) << " 10\n";
+    for (int j = 0; j < tube; ++j)
+      obj << "t crease 2/1/0 " << id(0, j) << " " << id(0, j + 1) << " 2\n";
+    meshes["torus_creases"] = {"catmull-clark", obj.str()};
+  }
+  // Open 6 x 6 grid with a height field: a boundary.
+  {
+    std::ostringstream obj;
+    const int n = 6;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        double x = double(i) / n - 0.5, y = double(j) / n - 0.5;
+        obj << "v " << x << " " << y << " " << 0.25 * std::sin(3 * x + 1) * std::cos(2 * y) << "\n";
+      }
+    }
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        int a = j * (n + 1) + i + 1;
+        obj << "f " << a << " " << a + 1 << " " << a + n + 2 << " " << a + n + 1 << "\n";
+      }
+    }
+    meshes["open_grid"] = {"catmull-clark", obj.str()};
+  }
+  {
+    const double t = (1 + std::sqrt(5.0)) / 2;
+    std::ostringstream obj;
+    double v[12][3] = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                       {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+    int f[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+    for (auto& p : v) obj << "v " << p[0] << " " << p[1] << " " << p[2] << "\n";
+    for (auto& tri : f) obj << "f " << tri[0] + 1 << " " << tri[1] + 1 << " " << tri[2] + 1 << "\n";
+    meshes["icosahedron"] = {"loop", obj.str()};
+  }
+  return meshes;
+}
+
+// One shared server for the whole file: starting one costs an EGL context per worker.
+class CorpusServer : public ::testing::Environment {
+ public:
+  static ServerProcess* server;
+  void SetUp() override { server = new ServerProcess(); }
+  void TearDown() override {
+    EXPECT_EQ(server->terminate(), 0);
+    delete server;
+  }
+};
+ServerProcess* CorpusServer::server = nullptr;
+const auto* const kEnvironment = ::testing::AddGlobalTestEnvironment(new CorpusServer);
+
+struct Rendered {
+  int status = 0;
+  rapidjson::Document body;
+};
+
+std::unique_ptr<Rendered> render(const std::string& obj, const std::string& scheme,
+                                 const std::string& method, int size, bool reference, int level = 0,
+                                 const std::string& extraOutputs = "") {
+  std::ostringstream request;
+  rapidjson::StringBuffer data;
+  {
+    rapidjson::Writer<rapidjson::StringBuffer> writer(data);
+    writer.String(obj.c_str(), static_cast<rapidjson::SizeType>(obj.size()));
+  }
+  request << R"({"mesh":{"format":"obj","scheme":")" << scheme << R"(","data":)" << data.GetString()
+          << R"(},"camera":{"width":)" << size << R"(,"height":)" << size << R"(},"method":")"
+          << method << R"(","params":{"level":)" << level
+          << R"(,"dicingRate":1},"outputs":["color")" << extraOutputs << R"(],"reference":)"
+          << (reference ? "true" : "false") << "}";
+  HttpResponse response = post(CorpusServer::server->port(), "/v1/render", request.str());
+  auto out = std::make_unique<Rendered>();
+  out->status = response.status;
+  out->body.Parse(response.body.c_str());
+  return out;
+}
+
+double hausdorff(const Rendered& r) {
+  return r.body["metrics"]["silhouette"]["hausdorffPx"].GetDouble();
+}
+
+// Whether all control points lie in one plane (a flat shape's coarse outline can be exact).
+bool isFlat(const std::string& obj) {
+  std::vector<std::array<double, 3>> points;
+  std::istringstream in(obj);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("v ", 0) == 0) {
+      std::istringstream v(line.substr(2));
+      std::array<double, 3> p{};
+      v >> p[0] >> p[1] >> p[2];
+      points.push_back(p);
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    bool same = std::all_of(points.begin(), points.end(), [&](const auto& p) {
+      return std::fabs(p[axis] - points[0][axis]) < 1e-9;
+    });
+    if (same) return true;
+  }
+  return false;
+}
+
+struct Shape {
+  std::string name, scheme, obj;
+};
+
+std::vector<Shape> allShapes() {
+  std::vector<Shape> shapes;
+  for (const auto& [name, mesh] : ownMeshes())
+    shapes.push_back({"own_" + name, mesh.first, mesh.second});
+  for (const std::string& name : corpusShapes()) {
+    shapes.push_back({name, schemeOf(name), readFile(kCorpus / (name + ".obj"))});
+  }
+  return shapes;
+}
+
+class EveryShape : public ::testing::TestWithParam<Shape> {};
+
+// Every method answers with an image (or, for a mesh OpenSubdiv refuses, a 422 naming why).
+TEST_P(EveryShape, EveryMethodAnswers) {
+  const Shape& shape = GetParam();
+  for (const char* method : {"coarse", "uniform", "adaptive", "limit"}) {
+    auto r = render(shape.obj, shape.scheme, method, 128, false, 2, R"(,"mask","depth","normal")");
+    if (r->status == 422) {
+      ASSERT_TRUE(r->body.HasMember("error")) << method;
+      EXPECT_STREQ(r->body["error"]["code"].GetString(), "invalid_mesh");
+      continue;
+    }
+    ASSERT_EQ(r->status, 200) << method;
+    ASSERT_TRUE(r->body["images"].HasMember("color")) << method;
+    EXPECT_EQ(r->body["images"]["color"]["width"].GetInt(), 128);
+    EXPECT_GT(std::string(r->body["images"]["color"]["data"].GetString()).size(), 100u);
+  }
+}
+
+// The acceptance criteria: adaptive (dicing rate 1) at 1024^2 is within a pixel of the exact
+// silhouette; the coarse cage is worse than adaptive unless the shape is flat; uniform level 4
+// beats level 1.
+TEST_P(EveryShape, ErrorsAgainstTheReference) {
+  const Shape& shape = GetParam();
+  if (shape.scheme == "bilinear") GTEST_SKIP() << "bilinear surfaces are their own cage";
+  auto adaptive = render(shape.obj, shape.scheme, "adaptive", 1024, true);
+  if (adaptive->status == 422) GTEST_SKIP() << "OpenSubdiv does not accept this mesh";
+  ASSERT_EQ(adaptive->status, 200);
+  double adaptivePx = hausdorff(*adaptive);
+  EXPECT_LE(adaptivePx, 1.0) << shape.name;
+  RecordProperty("adaptiveHausdorffPx", std::to_string(adaptivePx));
+  if (adaptive->body["stats"].HasMember("referenceCrossCheckPx")) {
+    EXPECT_LE(adaptive->body["stats"]["referenceCrossCheckPx"].GetDouble(), 0.1)
+        << "the two reference paths disagree";
+  }
+
+  auto coarse = render(shape.obj, shape.scheme, "coarse", 1024, true);
+  ASSERT_EQ(coarse->status, 200);
+  if (!isFlat(shape.obj)) EXPECT_GT(hausdorff(*coarse), adaptivePx) << shape.name;
+
+  auto level1 = render(shape.obj, shape.scheme, "uniform", 1024, true, 1);
+  auto level4 = render(shape.obj, shape.scheme, "uniform", 1024, true, 4);
+  ASSERT_EQ(level1->status, 200);
+  ASSERT_EQ(level4->status, 200);
+  EXPECT_LT(hausdorff(*level4), hausdorff(*level1)) << shape.name;
+}
+
+std::string testName(const ::testing::TestParamInfo<Shape>& info) { return info.param.name; }
+
+INSTANTIATE_TEST_SUITE_P(Shapes, EveryShape, ::testing::ValuesIn(allShapes()), testName);
+
+}  // namespace
+}  // namespace limn::testing

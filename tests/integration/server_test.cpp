@@ -1,0 +1,346 @@
+// The real `limn serve` process on 127.0.0.1: service endpoints, a render, every class of bad
+// request, limits, concurrency, back-pressure, timeouts, keep-alive and a clean SIGTERM.
+#include <gtest/gtest.h>
+#include <rapidjson/document.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/integration/http_client.h"
+#include "tests/integration/server_process.h"
+
+namespace limn::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A unit cube as OBJ text with JSON-escaped newlines.
+const char* kCubeObj =
+    "v -1 -1 1\\nv 1 -1 1\\nv -1 1 1\\nv 1 1 1\\nv -1 1 -1\\nv 1 1 -1\\nv -1 -1 -1\\nv 1 -1 -1\\n"
+    "f 1 2 4 3\\nf 3 4 6 5\\nf 5 6 8 7\\nf 7 8 2 1\\nf 2 8 6 4\\nf 7 1 3 5\\n";
+
+std::string renderBody(const std::string& method, int size, const std::string& extra = "") {
+  return std::string(R"({"mesh": {"format": "obj", "data": ")") + kCubeObj +
+         R"("}, "camera": {"width": )" + std::to_string(size) +
+         ", \"height\": " + std::to_string(size) + R"(}, "method": ")" + method + "\"" + extra +
+         "}";
+}
+
+std::string smallRender() { return renderBody("coarse", 64, R"(, "outputs": ["color"])"); }
+
+// About a second on llvmpipe (200k triangles at 1024^2, three passes): long enough that
+// requests sent together overlap, short enough to keep the tests quick.
+std::string slowRender() {
+  return renderBody("adaptive", 1024,
+                    R"(, "params": {"dicingRate": 0.25}, "outputs": ["color", "depth", "normal"])");
+}
+
+rapidjson::Document parseJson(const std::string& text) {
+  rapidjson::Document doc;
+  doc.Parse(text.c_str(), text.size());
+  return doc;
+}
+
+// The error code of a JSON error answer, or a description of what the body was instead.
+std::string errorCode(const HttpResponse& response) {
+  auto doc = parseJson(response.body);
+  if (doc.HasParseError() || !doc.IsObject() || !doc.HasMember("error") ||
+      !doc["error"].IsObject() || !doc["error"].HasMember("code")) {
+    return "<not a JSON error: " + response.body.substr(0, 200) + ">";
+  }
+  return doc["error"]["code"].GetString();
+}
+
+// A server shared by the tests that do not change its configuration.
+class ServerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    server_ = new ServerProcess(ServerProcess::withConfig(R"({"workers": 2, "queueDepth": 64})"));
+  }
+  static void TearDownTestSuite() {
+    EXPECT_EQ(server_->terminate(SIGTERM), 0) << "a clean shutdown exits with status 0";
+    delete server_;
+    server_ = nullptr;
+  }
+  static int port() { return server_->port(); }
+
+  static ServerProcess* server_;
+};
+ServerProcess* ServerTest::server_ = nullptr;
+
+TEST_F(ServerTest, HealthzDescribesTheService) {
+  HttpResponse r = get(port(), "/healthz");
+  ASSERT_EQ(r.status, 200);
+  EXPECT_EQ(r.header("Content-Type"), "application/json");
+  auto doc = parseJson(r.body);
+  ASSERT_FALSE(doc.HasParseError()) << r.body;
+  EXPECT_STREQ(doc["status"].GetString(), "ok") << r.body;
+  EXPECT_EQ(doc["workers"].GetInt(), 2);
+  EXPECT_EQ(doc["queueCapacity"].GetInt(), 64);
+  EXPECT_EQ(doc["queueDepth"].GetInt(), 0);
+  EXPECT_FALSE(std::string(doc["renderer"].GetString()).empty());
+  EXPECT_FALSE(std::string(doc["eglPlatform"].GetString()).empty());
+  EXPECT_FALSE(std::string(doc["version"].GetString()).empty());
+}
+
+TEST_F(ServerTest, ReadyzSaysReady) {
+  HttpResponse r = get(port(), "/readyz");
+  EXPECT_EQ(r.status, 200);
+  auto doc = parseJson(r.body);
+  ASSERT_FALSE(doc.HasParseError()) << r.body;
+  EXPECT_TRUE(doc["ready"].GetBool());
+}
+
+TEST_F(ServerTest, MetricsCountWhatWasAnswered) {
+  ASSERT_EQ(post(port(), "/v1/render", smallRender()).status, 200);
+  ASSERT_EQ(get(port(), "/no/such/thing").status, 404);
+  HttpResponse r = get(port(), "/metrics");
+  ASSERT_EQ(r.status, 200);
+  EXPECT_EQ(r.header("Content-Type").rfind("text/plain", 0), 0u);
+  EXPECT_NE(r.body.find("limn_requests_total{path=\"/v1/render\",status=\"200\"} "),
+            std::string::npos)
+      << r.body;
+  EXPECT_NE(r.body.find("limn_requests_total{path=\"other\",status=\"404\"} "), std::string::npos);
+  EXPECT_NE(r.body.find("limn_request_duration_seconds_count{path=\"/v1/render\"} "),
+            std::string::npos);
+  EXPECT_NE(r.body.find("\nlimn_queue_depth 0\n"), std::string::npos);
+  EXPECT_NE(r.body.find("\nlimn_workers_busy "), std::string::npos);
+  EXPECT_NE(r.body.find("\nlimn_render_seconds_count "), std::string::npos);
+}
+
+TEST_F(ServerTest, OpenApiDocumentDescribesRender) {
+  HttpResponse r = get(port(), "/openapi.json");
+  ASSERT_EQ(r.status, 200);
+  auto doc = parseJson(r.body);
+  ASSERT_FALSE(doc.HasParseError());
+  ASSERT_TRUE(doc.HasMember("paths"));
+  EXPECT_TRUE(doc["paths"].HasMember("/v1/render"));
+}
+
+TEST_F(ServerTest, RenderOfACubeAnswersAPng) {
+  HttpResponse r = post(port(), "/v1/render", smallRender());
+  ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+  auto doc = parseJson(r.body);
+  ASSERT_FALSE(doc.HasParseError());
+  const auto& color = doc["images"]["color"];
+  EXPECT_STREQ(color["mime"].GetString(), "image/png");
+  EXPECT_EQ(color["width"].GetInt(), 64);
+  EXPECT_EQ(color["height"].GetInt(), 64);
+  std::vector<unsigned char> png = decodeBase64(color["data"].GetString());
+  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  ASSERT_GT(png.size(), 24u);
+  EXPECT_TRUE(std::equal(signature, signature + 8, png.begin()));
+  // IHDR: width and height, big-endian, at bytes 16..23.
+  auto be32 = [&](size_t at) {
+    return (png[at] << 24) | (png[at + 1] << 16) | (png[at + 2] << 8) | png[at + 3];
+  };
+  EXPECT_EQ(be32(16), 64);
+  EXPECT_EQ(be32(20), 64);
+  EXPECT_EQ(doc["stats"]["controlFaces"].GetInt(), 6);
+}
+
+struct BadRequest {
+  const char* name;
+  std::string method, path, body;
+  int status;
+  const char* code;
+};
+
+TEST_F(ServerTest, EveryBadRequestGetsItsJsonErrorAndTheServerCarriesOn) {
+  const std::vector<BadRequest> cases = {
+      {"invalid JSON", "POST", "/v1/render", "{\"mesh\": ", 400, "invalid_json"},
+      {"unknown method", "POST", "/v1/render", renderBody("bogus", 64), 400, "invalid_request"},
+      {"face index out of range", "POST", "/v1/render",
+       R"({"mesh": {"format": "obj", "data": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"}})", 422,
+       "invalid_mesh"},
+      {"unknown path", "GET", "/v2/everything", "", 404, "not_found"},
+      {"wrong verb", "GET", "/v1/render", "", 405, "method_not_allowed"},
+      {"wrong verb on healthz", "POST", "/healthz", "{}", 405, "method_not_allowed"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    HttpResponse r = HttpClient(port()).request(c.method, c.path, c.body);
+    EXPECT_EQ(r.status, c.status) << r.body.substr(0, 300);
+    EXPECT_EQ(r.header("Content-Type"), "application/json");
+    EXPECT_EQ(errorCode(r), c.code);
+    if (c.status == 405) {
+      EXPECT_FALSE(r.header("Allow").empty());
+    }
+    EXPECT_EQ(post(port(), "/v1/render", smallRender()).status, 200);
+  }
+}
+
+TEST_F(ServerTest, MalformedHttpGets400Json) {
+  for (const char* garbage : {"HELLO\r\n\r\n", "GET /healthz HTTP/9.9\r\n\r\n",
+                              "POST /v1/render HTTP/1.1\r\nContent-Length: abc\r\n\r\n",
+                              "GET /healthz HTTP/1.1\r\nBad Header Line\r\n\r\n"}) {
+    SCOPED_TRACE(garbage);
+    HttpClient client(port());
+    client.send(garbage);
+    HttpResponse r = client.readResponse();
+    EXPECT_EQ(r.status, 400);
+    EXPECT_EQ(errorCode(r), "invalid_request");
+    EXPECT_TRUE(client.peerClosed()) << "a connection whose framing is lost is closed";
+  }
+  EXPECT_EQ(get(port(), "/healthz").status, 200);
+}
+
+TEST_F(ServerTest, KeepAliveServesSeveralRequestsOnOneConnection) {
+  HttpClient client(port());
+  HttpResponse first = client.request("GET", "/healthz");
+  EXPECT_EQ(first.status, 200);
+  EXPECT_NE(first.header("Connection"), "close");
+  HttpResponse second = client.request("POST", "/v1/render", smallRender());
+  EXPECT_EQ(second.status, 200);
+  HttpResponse third = client.request("GET", "/nothing-here");
+  EXPECT_EQ(third.status, 404);
+  HttpResponse fourth = client.request("GET", "/readyz");
+  EXPECT_EQ(fourth.status, 200);
+  EXPECT_FALSE(client.peerClosed(100ms));
+}
+
+TEST_F(ServerTest, ExpectContinueGetsTheGoAheadBeforeTheBody) {
+  std::string body = smallRender();
+  HttpClient client(port());
+  client.send(
+      "POST /v1/render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+      "Expect: 100-continue\r\nContent-Length: " +
+      std::to_string(body.size()) + "\r\n\r\n");
+  HttpResponse interim = client.readResponse();
+  EXPECT_EQ(interim.status, 100);
+  client.send(body);
+  EXPECT_EQ(client.readResponse().status, 200);
+}
+
+TEST_F(ServerTest, FiftyConcurrentClientsAllGetTheirRender) {
+  constexpr int kClients = 50;
+  std::vector<int> statuses(kClients, 0);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kClients; ++i) {
+    threads.emplace_back([&, i] {
+      try {
+        statuses[i] = post(port(), "/v1/render", smallRender()).status;
+      } catch (const std::exception&) {
+        statuses[i] = -1;
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  std::map<int, int> histogram;
+  for (int s : statuses) ++histogram[s];
+  // The queue (64) holds every one of them: no 429 either.
+  EXPECT_EQ(histogram[200], kClients) << "statuses: 200 x" << histogram[200] << ", 429 x "
+                                      << histogram[429] << ", failed x" << histogram[-1];
+}
+
+// ---- Servers with their own configuration ----
+
+TEST(ServerLimits, BodyOverTheLimitGets413AndTheServerCarriesOn) {
+  auto server = ServerProcess::withConfig(R"({"workers": 1, "maxBodyBytes": 2048})");
+  // Just over, and far over (the server must not reset the connection under the client's
+  // feet while it is still sending: the client reads the 413).
+  for (size_t size : {size_t{4096}, size_t{4} << 20}) {
+    SCOPED_TRACE(size);
+    std::string body = "{\"pad\": \"" + std::string(size, 'x') + "\"}";
+    HttpResponse r = post(server.port(), "/v1/render", body);
+    EXPECT_EQ(r.status, 413);
+    EXPECT_EQ(errorCode(r), "too_large");
+    EXPECT_NE(r.body.find("maxBodyBytes"), std::string::npos) << r.body;
+  }
+  {
+    // With Expect: 100-continue the client learns it without sending the body at all.
+    HttpClient client(server.port());
+    client.send(
+        "POST /v1/render HTTP/1.1\r\nHost: x\r\nExpect: 100-continue\r\n"
+        "Content-Length: 100000\r\n\r\n");
+    HttpResponse r = client.readResponse();
+    EXPECT_EQ(r.status, 413);
+    EXPECT_EQ(errorCode(r), "too_large");
+    EXPECT_TRUE(client.peerClosed());
+  }
+  EXPECT_EQ(post(server.port(), "/v1/render", smallRender()).status, 200);
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+}
+
+TEST(ServerLimits, FullQueueAnswers429WithRetryAfter) {
+  auto server = ServerProcess::withConfig(R"({"workers": 1, "queueDepth": 1})");
+  constexpr int kClients = 6;
+  std::vector<HttpResponse> answers(kClients);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kClients; ++i) {
+    threads.emplace_back([&, i] { answers[i] = post(server.port(), "/v1/render", slowRender()); });
+  }
+  for (auto& t : threads) t.join();
+  int ok = 0, busy = 0;
+  for (const auto& a : answers) {
+    if (a.status == 200) ++ok;
+    if (a.status == 429) {
+      ++busy;
+      EXPECT_EQ(errorCode(a), "busy");
+      ASSERT_FALSE(a.header("Retry-After").empty());
+      EXPECT_GE(std::stoi(a.header("Retry-After")), 1);
+    }
+  }
+  EXPECT_EQ(ok + busy, kClients);
+  EXPECT_GE(ok, 1);
+  EXPECT_GE(busy, 1) << "one worker and one queue slot cannot take " << kClients << " at once";
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+}
+
+TEST(ServerLimits, RequestTimeoutGets504AndFreesTheWorker) {
+  auto server = ServerProcess::withConfig(R"({"workers": 1, "requestTimeoutMs": 1})");
+  auto start = std::chrono::steady_clock::now();
+  HttpResponse r = post(server.port(), "/v1/render", slowRender());
+  EXPECT_EQ(r.status, 504) << r.body.substr(0, 300);
+  EXPECT_EQ(errorCode(r), "timeout");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  // The worker notices its cancelled token and becomes free again.
+  int busy = -1;
+  for (int i = 0; i < 200 && busy != 0; ++i) {
+    auto doc = parseJson(get(server.port(), "/healthz").body);
+    busy = doc["busyWorkers"].GetInt();
+    if (busy != 0) std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(busy, 0);
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+}
+
+TEST(ServerShutdown, SigtermWhileARenderIsInFlightAnswersItAndExitsCleanly) {
+  auto server = ServerProcess::withConfig(R"({"workers": 1})");
+  std::atomic<int> status{0};
+  std::thread client([&] {
+    try {
+      status = post(server.port(), "/v1/render", slowRender()).status;
+    } catch (const std::exception&) {
+      status = -1;
+    }
+  });
+  // Wait until the render is really running.
+  for (int i = 0; i < 400; ++i) {
+    auto doc = parseJson(get(server.port(), "/healthz").body);
+    if (doc["busyWorkers"].GetInt() > 0) break;
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+  client.join();
+  EXPECT_TRUE(status == 200 || status == 503) << "status " << status;
+}
+
+TEST(ServerShutdown, SigintIsACleanShutdownToo) {
+  ServerProcess server;
+  HttpClient idle(server.port());  // an idle keep-alive connection must not hold it up
+  EXPECT_EQ(idle.request("GET", "/healthz").status, 200);
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(server.terminate(SIGINT), 0);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  EXPECT_TRUE(idle.peerClosed());
+}
+
+}  // namespace
+}  // namespace limn::testing
