@@ -83,14 +83,14 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
                                        std::to_string(mesh.faceVertexIndices.size()) +
                                        " entries but faceVertexCounts needs more (at " + face + ")");
     }
+    // A face may repeat a vertex (the corpus's non-manifold shapes do): OpenSubdiv accepts
+    // such faces as non-manifold topology, so limn does too.
     for (int i = 0; i < n; ++i) {
       int v = mesh.faceVertexIndices[offset + i];
       if (v < 0 || v >= mesh.vertexCount()) {
         invalid(face, face + " refers to vertex " + std::to_string(v) + ", outside 0.." +
                           std::to_string(mesh.vertexCount() - 1));
       }
-      int next = mesh.faceVertexIndices[offset + (i + 1) % n];
-      if (v == next) invalid(face, face + " repeats vertex " + std::to_string(v) + " on an edge");
     }
     for (int i = 0; i < n; ++i) {
       edges.insert(edgeKey(mesh.faceVertexIndices[offset + i],

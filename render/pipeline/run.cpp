@@ -109,7 +109,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
 
   const subdiv::LimitSurface surface(job.mesh);
   Camera camera = resolveCamera(job.camera, surface.bounds());
-  RenderResult result{.camera = camera};
+  RenderResult result{.images = {}, .referenceImages = {}, .metrics = {}, .stats = {},
+                      .timings = {}, .warnings = {}, .camera = camera};
   result.timings.surfaceMs = clock.lapMs();
   result.stats.controlVertices = job.mesh.vertexCount();
   result.stats.controlFaces = job.mesh.faceCount();
