@@ -12,8 +12,10 @@
 #include <thread>
 
 #include "api/render_api.h"
+#include "server/http_server.h"
 #include "server/router.h"
 #include "server/worker_pool.h"
+#include "tests/integration/http_client.h"
 
 namespace limn::server {
 namespace {
@@ -328,6 +330,39 @@ TEST_F(RouterTest, RenderRunsOnTheWorkerPool) {
   api::Answer bad = route(router, "POST", "/v1/render", "{not json");
   EXPECT_EQ(bad.status, 400);
   EXPECT_EQ(errorCode(bad), "invalid_json");
+}
+
+// ---- HttpServer in process, for the limits the process tests cannot wait for ----
+
+TEST(HttpServer, SlowRequestsGet408AndIdleConnectionsAreClosed) {
+  WorkerPool pool(options(1, 2));
+  Router router(render::pipeline::JobLimits{}, pool);
+  HttpOptions http;
+  http.port = 0;
+  http.readTimeout = 300ms;
+  HttpServer server(http, router, pool);
+  std::thread serving([&server] { server.run(); });
+
+  {
+    // Slowloris: a header that never ends.
+    limn::testing::HttpClient slow(server.port());
+    slow.send("GET /healthz HTTP/1.1\r\nHost: x\r\nX-Slow: ");
+    auto start = std::chrono::steady_clock::now();
+    limn::testing::HttpResponse r = slow.readResponse();
+    EXPECT_EQ(r.status, 408);
+    EXPECT_NE(r.body.find("\"code\":\"timeout\""), std::string::npos) << r.body;
+    EXPECT_GE(std::chrono::steady_clock::now() - start, 250ms);
+    EXPECT_TRUE(slow.peerClosed());
+  }
+  {
+    // A keep-alive connection that stays idle after its answer is closed without a word.
+    limn::testing::HttpClient idle(server.port());
+    EXPECT_EQ(idle.request("GET", "/readyz").status, 200);
+    EXPECT_FALSE(idle.peerClosed(100ms));
+    EXPECT_TRUE(idle.peerClosed(2000ms));
+  }
+  server.stop();
+  serving.join();
 }
 
 }  // namespace
