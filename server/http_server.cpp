@@ -128,7 +128,17 @@ void HttpServer::run() {
   auto work = net::make_work_guard(s.ioc);
   std::vector<std::thread> threads;
   for (int i = 0; i < std::max(1, s.options.ioThreads); ++i) {
-    threads.emplace_back([&s] { s.ioc.run(); });
+    threads.emplace_back([&s] {
+      // A handler that throws must not take the process down with it: log and carry on.
+      for (;;) {
+        try {
+          s.ioc.run();
+          return;
+        } catch (const std::exception& e) {
+          std::cerr << "limn: IO thread: " << e.what() << "\n";
+        }
+      }
+    });
   }
 
   {

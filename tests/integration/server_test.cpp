@@ -191,6 +191,16 @@ TEST_F(ServerTest, MalformedHttpGets400Json) {
   EXPECT_EQ(get(port(), "/healthz").status, 200);
 }
 
+TEST_F(ServerTest, OversizedHeaderGets431Json) {
+  HttpClient client(port());
+  client.send("GET /healthz HTTP/1.1\r\nHost: x\r\nX-Big: " + std::string(64 * 1024, 'a') +
+              "\r\n\r\n");
+  HttpResponse r = client.readResponse();
+  EXPECT_EQ(r.status, 431);
+  EXPECT_EQ(errorCode(r), "too_large");
+  EXPECT_EQ(get(port(), "/healthz").status, 200);
+}
+
 TEST_F(ServerTest, KeepAliveServesSeveralRequestsOnOneConnection) {
   HttpClient client(port());
   HttpResponse first = client.request("GET", "/healthz");
