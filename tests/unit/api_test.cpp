@@ -366,8 +366,8 @@ TEST(ObjReader, BadIndicesNameTheLine) {
   EXPECT_EQ(text.subject(), "line 4");
   InputError slashes = objError(tri + "f 1/1/1/1 2 3\n");
   EXPECT_EQ(slashes.subject(), "line 4");
-  InputError repeated = objError(tri + "f 1 2 2\n");
-  EXPECT_TRUE(contains(repeated.what(), "OBJ line 4")) << repeated.what();
+  // A face that repeats a vertex is non-manifold, not malformed: OpenSubdiv takes it.
+  EXPECT_NO_THROW(api::readObj(tri + "f 1 2 2\n", render::mesh::Scheme::CatmullClark, {}));
 }
 
 TEST(ObjReader, BadCoordinatesNameTheLine) {
@@ -1003,7 +1003,7 @@ TEST(HandleRender, TurnsEveryFailureIntoAJsonError) {
   EXPECT_EQ(bad.status, 400);
   EXPECT_STREQ(parseBody(bad)["error"]["code"].GetString(), "invalid_json");
 
-  api::Answer mesh = api::handleRender(objRequest("v 0 0 0\nf 1 1 1\n"), limits, context, cancel);
+  api::Answer mesh = api::handleRender(objRequest("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), limits, context, cancel);
   EXPECT_EQ(mesh.status, 422);
   EXPECT_STREQ(parseBody(mesh)["error"]["code"].GetString(), "invalid_mesh");
 
