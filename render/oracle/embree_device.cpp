@@ -3,17 +3,17 @@
 #include <pmmintrin.h>  // DAZ (SSE3)
 #include <xmmintrin.h>  // FTZ
 
-#include <mutex>
 #include <stdexcept>
 
 namespace limn::render::oracle {
 
 namespace {
 
-// Embree reports errors through a callback; the message is kept (per device, under a lock,
-// since the callback may run on a builder thread) so a caller can say what Embree objected to.
-std::mutex errorMutex;
-std::string lastError;
+// Embree reports errors through a callback, called on the thread whose API call failed (errors
+// inside a parallel build surface at the call that started it). The message is kept per thread,
+// so concurrent requests sharing the device each see their own, and a caller can say what
+// Embree objected to.
+thread_local std::string lastError;
 
 const char* errorName(RTCError code) {
   switch (code) {
@@ -29,7 +29,6 @@ const char* errorName(RTCError code) {
 }
 
 void recordError(void*, RTCError code, const char* message) {
-  std::lock_guard<std::mutex> lock(errorMutex);
   if (lastError.empty()) {
     lastError = std::string(errorName(code)) + (message ? std::string(": ") + message : "");
   }
@@ -50,7 +49,6 @@ RTCDevice embreeDevice() {
 
 std::string takeEmbreeError() {
   RTCError code = rtcGetDeviceError(embreeDevice());
-  std::lock_guard<std::mutex> lock(errorMutex);
   std::string message = std::move(lastError);
   lastError.clear();
   if (message.empty() && code != RTC_ERROR_NONE) message = errorName(code);

@@ -16,7 +16,7 @@ namespace limn::render::oracle {
 // The shared device. Thread-safe.
 RTCDevice embreeDevice();
 
-// Embree's last error on the device since the previous call, as "code: message", or "" when
+// Embree's last error on this thread since the previous call, as "code: message", or "" when
 // there was none. Clears it.
 std::string takeEmbreeError();
 

@@ -85,11 +85,20 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
   const tessellate::TriangleMesh& mesh = tessellation.mesh;
   stats.triangles = mesh.triangleCount();
   stats.outlineFaces = tessellation.outlineFaces;
+  stats.outlineErrorPx = tessellation.outlineErrorPx;
+  if (tessellation.outlineErrorPx > kOutlineChordErrorPx * 1.0001) {
+    result.warnings.push_back(
+        "reference: outline chord error raised to " + std::to_string(tessellation.outlineErrorPx) +
+        " px (from " + std::to_string(kOutlineChordErrorPx) + ") to stay within " +
+        std::to_string(static_cast<long>(kReferenceTriangleBudget)) + " triangles");
+  }
   stats.tessellateMs = msSince(start);
   cancel.check();
 
   start = Clock::now();
-  EmbreeScene scene = buildTriangleScene(mesh);
+  // Build quality: see triangle_scene.h for the measurements behind this choice.
+  EmbreeScene scene = buildTriangleScene(
+      mesh, passes.supersample > 0 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW);
   stats.bvhMs = msSince(start);
   cancel.check();
 

@@ -27,6 +27,7 @@ struct ReferenceStats {
   size_t newtonFailures = 0;   // hits whose refinement did not converge (kept unrefined)
   double tessellateMs = 0, bvhMs = 0, traceMs = 0;
   size_t outlineFaces = 0;     // faces tessellated finely because they carry an outline
+  double outlineErrorPx = 0;   // chord error aimed for at the outline, output pixels
   size_t hits = 0;             // output pixels covered
   double newtonMs = 0;         // refinement and shading of the hits (traceMs: primary rays only)
   double maskMs = 0;           // the supersampled mask's rays

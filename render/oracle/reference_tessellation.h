@@ -2,18 +2,18 @@
 //
 // Rays hit triangles first and are then moved onto the limit surface, so inside the outline the
 // triangles only need to be fine enough for Newton to start close; at the outline, though, the
-// triangles decide coverage, and their chord error is the reference mask's error. So faces that
-// carry an outline get a density (AdaptiveOptions::density) that brings the chord error there
-// below kOutlineChordErrorPx output pixels; the rest is diced at kReferenceDicingRate.
+// triangles decide coverage, and their chord error is the reference mask's error. So the edges of
+// faces that carry an outline get enough segments (AdaptiveOptions::minSegments) to bring the
+// chord error there below kOutlineChordErrorPx output pixels; the rest is diced at
+// kReferenceDicingRate.
 //
 // A face carries an outline when the facing of its limit surface, g = dot(n, view), changes
 // sign over a grid of samples (or comes within the normal's variation of zero), when it borders
-// a boundary or a hole, or when it borders a crease across which facing changes. Its density
-// comes from the curvature estimated from the samples: a chord of length s on a curve of radius
-// R deviates by s^2 / (8 R), so s = sqrt(8 e R) meets error e. The adaptive tessellator measures
-// edges by their projected length, which at the silhouette is foreshortened (an edge running
-// towards the viewer looks short but is curved); the density is computed against that measure,
-// per edge, so every edge of an outline face gets at least the segments its true length needs.
+// a boundary or a hole, or when it borders a crease across which facing changes (see
+// surface_probe.h for the samples and the segment counts). The segments are given per edge
+// (AdaptiveOptions::minSegments), from 3D lengths: a per-face density on the tessellator's
+// projected lengths would refine a silhouette face's transverse edges as much as its
+// foreshortened ones, 50 times more triangles on the corpus torus at 1024^2.
 #pragma once
 
 #include "render/core/camera.h"
@@ -30,17 +30,20 @@ inline constexpr double kReferenceDicingRate = 2.0;
 inline constexpr double kOutlineChordErrorPx = 0.01;
 // Segments per edge at most (Bfr tessellation rate).
 inline constexpr int kReferenceMaxEdgeRate = 512;
+// Triangles the reference aims to stay within (estimated before tessellating; Embree needs
+// roughly 100 bytes per triangle). Beyond it the outline error and the dicing rate are raised
+// together, and the caller is told.
+inline constexpr double kReferenceTriangleBudget = 3e6;
 
 struct ReferenceTessellation {
   tessellate::TriangleMesh mesh;
-  size_t outlineFaces = 0;  // faces tessellated with an outline density
+  size_t outlineFaces = 0;    // faces whose edges were refined for an outline
+  double outlineErrorPx = 0;  // the chord error aimed for at outlines (output pixels)
+  double dicingRate = 0;      // the edge length aimed for elsewhere (output pixels)
 };
 
 // `camera` is the output camera (not the supersampled one).
 ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface,
                                              const Camera& camera, const CancelToken& cancel);
-
-// The per-face densities used above (exposed for tests): 1 away from outlines.
-std::vector<double> outlineDensities(const subdiv::LimitSurface& surface, const Camera& camera);
 
 }  // namespace limn::render::oracle

@@ -10,6 +10,7 @@
 #include "render/oracle/embree_device.h"
 #include "render/oracle/ray_caster.h"
 #include "render/oracle/reference.h"
+#include "render/oracle/surface_probe.h"
 
 namespace limn::render::oracle {
 
@@ -21,8 +22,13 @@ namespace {
 constexpr int kEmbreeMaxFaceSize = 15;
 // Edge levels: Embree dices each edge into `level` segments, 1 to 4096.
 constexpr float kMaxLevel = 4096.0f;
-// Target grid spacing in pixels of the camera (the supersampled one when used for masks).
-constexpr double kGridPx = 0.5;
+// Embree's grid: chord error and longest piece, in pixels of the camera it is given (the
+// supersampled one when used for masks), and the most grid points it may make.
+constexpr double kChordErrorPx = 0.02;
+constexpr double kMaxGridPx = 8.0;
+constexpr double kMaxGridPoints = 32e6;
+// Offset of the rays that tell a crack from a hole, in pixels.
+constexpr double kCrackProbePx = 0.05;
 
 // Why Embree cannot represent this mesh as OpenSubdiv subdivides it, or "" when it can.
 std::string unsupportedReason(const subdiv::LimitSurface& surface) {
@@ -139,19 +145,60 @@ float embreeSharpness(float s) {
   return s >= mesh::kInfiniteSharpness ? INFINITY : s;
 }
 
-// Segments for the edge between control vertices a and b: its length seen at the nearer end,
-// over the target grid spacing. Measured in 3D (times pixels per unit), not projected, so that
-// edges running towards the viewer at the silhouette are not under-sampled. A function of the
-// two endpoints only, so both half-edges of an edge get the same level (watertight grids).
-float edgeLevel(const subdiv::LimitSurface& surface, const Camera& camera, int a, int b) {
-  const Vec3& pa = surface.controlLimitPositions()[a];
-  const Vec3& pb = surface.controlLimitPositions()[b];
-  const Vec3& ca = surface.mesh().points[a];
-  const Vec3& cb = surface.mesh().points[b];
-  double chord = std::max(length(pb - pa), length(cb - ca));
-  double depth = std::max(std::min(camera.depthOf(pa), camera.depthOf(pb)), camera.nearPlane());
-  double segments = std::ceil(chord * camera.pixelsPerUnit(depth) / kGridPx);
-  return static_cast<float>(std::clamp(segments, 1.0, static_cast<double>(kMaxLevel)));
+// Embree's one tessellation level for all edges (see the caller): enough segments for every edge
+// to keep its chords within kChordErrorPx of the surface (surface_probe.h; 3D lengths, so edges
+// running towards the viewer at the silhouette are not under-sampled), and pieces of at most
+// kMaxGridPx, capped so that the grids stay within kMaxGridPoints. (A grid of 0.5 px everywhere,
+// the first plan, took a minute at 1024^2 x 4 on a 1000-face mesh: Embree builds every grid up
+// front.)
+float uniformLevel(const subdiv::LimitSurface& surface, const Camera& camera) {
+  double level = 1, patches = 0;
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    int size = surface.mesh().faceVertexCounts[f];
+    patches += size == 4 ? 1 : size;  // Embree splits other faces into quads
+  }
+  for (const FaceProbe& probe : probeFaces(surface, camera)) {
+    for (size_t k = 0; k < probe.segmentsAtOnePixel.size(); ++k) {
+      level = std::max({level, probe.segmentsAtOnePixel[k] / std::sqrt(kChordErrorPx),
+                        probe.lengthPx[k] / kMaxGridPx});
+    }
+  }
+  double cap = std::sqrt(kMaxGridPoints / std::max(patches, 1.0));
+  return static_cast<float>(std::clamp(std::ceil(level), 1.0, std::min(cap, double(kMaxLevel))));
+}
+
+// Embree's grids of neighbouring patches are evaluated separately and can leave cracks of zero
+// width between them, through which an occasional ray slips (measured: one pixel in 10^5 on an
+// open 3-face mesh). A missed pixel whose four neighbours are covered is cast again at four
+// points kCrackProbePx around its centre: a hole in the surface has area, a crack does not.
+void closeCracks(RTCScene scene, const Camera& camera, Image& mask) {
+  const int w = mask.width, h = mask.height;
+  std::vector<std::pair<int, int>> suspects;
+  for (int y = 1; y + 1 < h; ++y) {
+    for (int x = 1; x + 1 < w; ++x) {
+      if (mask.at(x, y) == 0 && mask.at(x - 1, y) > 0 && mask.at(x + 1, y) > 0 &&
+          mask.at(x, y - 1) > 0 && mask.at(x, y + 1) > 0) {
+        suspects.emplace_back(x, y);
+      }
+    }
+  }
+  FlushDenormalsScope ftz;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (auto [x, y] : suspects) {
+    int hits = 0;
+    for (auto [dx, dy] : {std::pair{-1, -1}, {1, -1}, {-1, 1}, {1, 1}}) {
+      PixelRay r = pixelRay(camera, x + 0.5 + dx * kCrackProbePx, y + 0.5 + dy * kCrackProbePx);
+      Vec3 o = r.origin + r.direction * r.tNear;
+      RTCRay ray{static_cast<float>(o.x), static_cast<float>(o.y), static_cast<float>(o.z), 0.0f,
+                 static_cast<float>(r.direction.x), static_cast<float>(r.direction.y),
+                 static_cast<float>(r.direction.z), 0.0f, static_cast<float>(r.tFar - r.tNear),
+                 0xFFFFFFFFu, 0, 0};
+      rtcOccluded1(scene, &context, &ray);
+      hits += ray.tfar < 0.0f;
+    }
+    if (hits >= 3) mask.at(x, y) = 1.0f;
+  }
 }
 
 template <typename T>
@@ -195,18 +242,19 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
     vertices[i] = {static_cast<float>(m.points[i].x), static_cast<float>(m.points[i].y),
                    static_cast<float>(m.points[i].z)};
   }
+  // One level for all edges: where a face's edges have different levels Embree stitches its grid
+  // with T-junctions, and rays slip through the cracks (pinholes measured on an open grid).
+  const float level = uniformLevel(surface, camera);
   size_t offset = 0;
   for (int f = 0; f < m.faceCount(); ++f) {
     int size = m.faceVertexCounts[f];
     faces[f] = static_cast<unsigned>(size);
     for (int k = 0; k < size; ++k) {
-      int a = m.faceVertexIndices[offset + k];
-      int b = m.faceVertexIndices[offset + (k + 1) % size];
-      indices[offset + k] = static_cast<unsigned>(a);
-      levels[offset + k] = edgeLevel(surface, camera, a, b);
+      indices[offset + k] = static_cast<unsigned>(m.faceVertexIndices[offset + k]);
     }
     offset += size;
   }
+  std::fill(levels, levels + m.faceVertexIndices.size(), level);
   if (!m.creases.empty()) {
     auto* pairs = newBuffer<unsigned[2]>(g, RTC_BUFFER_TYPE_EDGE_CREASE_INDEX, RTC_FORMAT_UINT2,
                                          m.creases.size());
@@ -243,7 +291,9 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
     return refuse("Embree rejected the subdivision mesh: " + error);
   }
   cancel.check();
-  return castCoverage(scene.get(), camera, RayPacking::Packet16, cancel);
+  Image mask = castCoverage(scene.get(), camera, RayPacking::Packet16, cancel);
+  closeCracks(scene.get(), camera, mask);
+  return mask;
 }
 
 }  // namespace limn::render::oracle

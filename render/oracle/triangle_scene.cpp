@@ -7,11 +7,16 @@ namespace limn::render::oracle {
 EmbreeScene buildTriangleScene(const tessellate::TriangleMesh& mesh, RTCBuildQuality quality) {
   FlushDenormalsScope ftz;
   RTCDevice device = embreeDevice();
+  takeEmbreeError();  // report only this scene's errors
   EmbreeScene scene(rtcNewScene(device));
   // ROBUST: watertight edge tests, so rays through a shared edge or vertex always hit.
   rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(scene.get(), quality);
 
+  if (mesh.triangleCount() == 0) {  // nothing in view or no limit surface: every ray misses
+    rtcCommitScene(scene.get());
+    return scene;
+  }
   RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryBuildQuality(geometry, quality);
   // Buffers Embree allocates itself carry the padding its SIMD loads need past the last vertex.

@@ -10,8 +10,9 @@
 
 namespace limn::render::oracle {
 
-// RTC_BUILD_QUALITY_MEDIUM is the default: see oracle_test's timing output for the trade-off.
-EmbreeScene buildTriangleScene(const tessellate::TriangleMesh& mesh,
-                               RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM);
+// Measured on 0.8M triangles, 2 threads (best of 4): build / 1024^2 closest hits / 4096^2
+// occlusion rays: LOW 39 / 54 / 496 ms, MEDIUM 158 / 52 / 396 ms, HIGH 138 / 46 / 393 ms. So LOW
+// when only primary rays are cast, HIGH when a supersampled mask follows.
+EmbreeScene buildTriangleScene(const tessellate::TriangleMesh& mesh, RTCBuildQuality quality);
 
 }  // namespace limn::render::oracle

@@ -191,6 +191,11 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
       edgeRate[edges[k]] = std::max(edgeRate[edges[k]], rate);
     }
   }
+  if (options.minSegments) {
+    for (int e = 0; e < base.GetNumEdges(); ++e) {
+      edgeRate[e] = std::clamp(options.minSegments(e), edgeRate[e], options.maxEdgeRate);
+    }
+  }
 
   // 3. Tessellate and evaluate every face.
   std::vector<FacePatch> patches(faceCount);

@@ -29,6 +29,10 @@ struct AdaptiveOptions {
   // Optional per-face density: the target edge length for face f is dicingRate / density(f).
   // The reference uses it to tessellate faces near the silhouette more finely.
   std::function<double(int face)> density;
+  // Optional lower bound on the segments of base-level edge e (then capped by maxEdgeRate),
+  // applied whether or not its faces are culled. Projected lengths are foreshortened where the
+  // surface turns away at the silhouette; the reference bounds those edges by their 3D length.
+  std::function<int(int edge)> minSegments;
 };
 
 TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camera& camera,

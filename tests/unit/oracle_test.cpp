@@ -9,9 +9,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include "render/core/error.h"
 #include "render/core/shading.h"
@@ -550,6 +552,79 @@ TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
     ++compared;
   }
   EXPECT_GT(compared, 10);
+}
+
+
+// ---- Timings (run with --gtest_also_run_disabled_tests; prints a table, asserts nothing) ----
+
+namespace timing {
+
+// Best of three runs: the machine is shared, the minimum is the least disturbed.
+double msOf(const std::function<void()>& f) {
+  double best = 1e300;
+  for (int run = 0; run < 3; ++run) {
+    auto start = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double, std::milli>(
+                              std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, int size, int S) {
+  subdiv::LimitSurface surface(m);
+  Camera camera = viewOf(surface, size, offset);
+  ReferenceResult r = renderReference(surface, camera, allPasses(S), {});
+  const ReferenceStats& st = r.stats;
+  std::printf("%s (%d faces) at %d^2, S = %d, %u threads\n", name.c_str(), m.faceCount(), size, S,
+              std::thread::hardware_concurrency());
+  std::printf("  dense tessellation  %9.1f ms  %zu triangles, %zu outline faces\n",
+              st.tessellateMs, st.triangles, st.outlineFaces);
+  std::printf("  BVH (medium)        %9.1f ms\n", st.bvhMs);
+  std::printf("  primary rays        %9.1f ms  %d rays (packets of 16)\n", st.traceMs, size * size);
+  std::printf("  Newton + shading    %9.1f ms  %zu hits, %zu not refined\n", st.newtonMs, st.hits,
+              st.newtonFailures);
+  std::printf("  supersampled mask   %9.1f ms  %d rays (occlusion packets of 16)\n", st.maskMs,
+              size * size * S * S);
+
+  // Alternatives, on the same tessellation.
+  ReferenceTessellation tess = tessellateForReference(surface, camera, {});
+  for (RTCBuildQuality q : {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH}) {
+    EmbreeScene scene;
+    double build = msOf([&] { scene = buildTriangleScene(tess.mesh, q); });
+    double p16 = msOf([&] { castClosestHits(scene.get(), camera, RayPacking::Packet16, {}); });
+    double p1 = msOf([&] { castClosestHits(scene.get(), camera, RayPacking::Single, {}); });
+    Camera fine = camera.scaled(S);
+    double m16 = msOf([&] { castCoverage(scene.get(), fine, RayPacking::Packet16, {}); });
+    double m1 = msOf([&] { castCoverage(scene.get(), fine, RayPacking::Single, {}); });
+    std::printf("  quality %-6s BVH %7.1f ms | primary: packet16 %7.1f, single %7.1f ms | "
+                "mask: packet16 %7.1f, single %7.1f ms\n",
+                q == RTC_BUILD_QUALITY_LOW ? "low" : q == RTC_BUILD_QUALITY_MEDIUM ? "medium" : "high",
+                build, p16, p1, m16, m1);
+  }
+  std::string whyNot;
+  std::optional<Image> embree;
+  double subdivMs = msOf([&] { embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot); });
+  if (embree) {
+    metrics::SilhouetteMetrics sm =
+        metrics::compareSilhouettes(*embree, r.images.supersampledMask, S);
+    std::printf("  Embree subdivision  %9.1f ms  (cross-check hausdorff %.3f px, mean %.5f px)\n",
+                subdivMs, sm.hausdorffPx, sm.meanPx);
+  } else {
+    std::printf("  Embree subdivision: %s\n", whyNot.c_str());
+  }
+}
+
+}  // namespace timing
+
+TEST(OracleTiming, DISABLED_ThousandFacesAt1024) {
+  timing::timeReference("torus 40 x 25", testing::torus(40, 25, false), {0.4, -1.2, 2.4}, 1024, 4);
+  std::filesystem::path torus = corpusDir() / "catmark_torus.obj";
+  if (std::optional<ControlMesh> m = readCorpusObj(torus)) {
+    subdiv::LimitSurface s(*m);
+    timing::timeReference("corpus catmark_torus", *m, Vec3{0.3, 0.45, 0.85} * s.bounds().diagonal(),
+                          1024, 4);
+  }
 }
 
 }  // namespace
