@@ -112,6 +112,7 @@ std::unique_ptr<Far::TopologyRefiner> makeRefiner(const mesh::ControlMesh& m) {
 
 LimitSurface::LimitSurface(mesh::ControlMesh mesh)
     : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(makeRefiner(mesh_)) {
+  rejectUnsupportedTopology();
   buildFaceSurfaces();
   computeControlLimits();
 }
@@ -123,6 +124,24 @@ std::unique_ptr<Far::TopologyRefiner> LimitSurface::createRefiner() const {
 }
 
 const Far::TopologyLevel& LimitSurface::baseLevel() const { return refiner_->GetLevel(0); }
+
+// OpenSubdiv 3.5.0 (the Debian 12 version) reads uninitialised memory and may crash when Bfr
+// builds the irregular patch of a face around an interior vertex of valence 2 (fixed upstream
+// after 3.6). Such meshes are refused with a 422 that names the vertex, rather than risking the
+// worker process.
+void LimitSurface::rejectUnsupportedTopology() const {
+  if (mesh_.scheme == mesh::Scheme::Bilinear) return;  // bilinear faces have no irregular patches
+  const Far::TopologyLevel& base = baseLevel();
+  for (int v = 0; v < base.GetNumVertices(); ++v) {
+    Far::ConstIndexArray edges = base.GetVertexEdges(v);
+    if (edges.size() != 2 || base.IsVertexBoundary(v) || base.IsVertexNonManifold(v)) continue;
+    if (base.GetVertexFaces(v).size() != 2) continue;
+    throw InputError(InputError::Kind::InvalidMesh, "vertex " + std::to_string(v),
+                     "vertex " + std::to_string(v) +
+                         " is an interior vertex of valence 2: the OpenSubdiv version limn runs "
+                         "on (3.5.0) cannot evaluate the limit surface around it safely");
+  }
+}
 
 void LimitSurface::buildFaceSurfaces() {
   Bfr::RefinerSurfaceFactory<>::Options options;

@@ -34,7 +34,8 @@ struct LimitSample {
 
 class LimitSurface {
  public:
-  // Throws InputError(InvalidMesh) when OpenSubdiv cannot build the topology.
+  // Throws InputError(InvalidMesh) when OpenSubdiv cannot build the topology, or when it has
+  // an interior vertex of valence 2 (OpenSubdiv 3.5.0's Bfr mishandles those).
   explicit LimitSurface(mesh::ControlMesh mesh);
   ~LimitSurface();
   LimitSurface(const LimitSurface&) = delete;
@@ -70,6 +71,7 @@ class LimitSurface {
 
  private:
   struct FaceSurface;
+  void rejectUnsupportedTopology() const;
   void buildFaceSurfaces();
   void computeControlLimits();
 

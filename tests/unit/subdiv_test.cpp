@@ -124,3 +124,26 @@ TEST(LimitSurface, EvaluationIsThreadSafe) {
 
 }  // namespace
 }  // namespace limn::render::subdiv
+
+namespace limn::render::subdiv {
+namespace {
+
+TEST(LimitSurface, RefusesInteriorValenceTwoVertices) {
+  // A closed "pillow" of three quads: vertices 0, 2 and 4 are interior with valence 2.
+  mesh::ControlMesh m;
+  m.points = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 0.2}};
+  testing::addFace(m, {0, 1, 4, 3});
+  testing::addFace(m, {1, 2, 3, 4});
+  testing::addFace(m, {0, 3, 2, 1});
+  try {
+    LimitSurface surface(m);
+    FAIL() << "expected a refusal";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), InputError::Kind::InvalidMesh);
+    EXPECT_EQ(e.subject(), "vertex 0");
+    EXPECT_NE(std::string(e.what()).find("valence 2"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace limn::render::subdiv
