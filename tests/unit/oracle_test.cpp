@@ -580,7 +580,7 @@ void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, i
               std::thread::hardware_concurrency());
   std::printf("  dense tessellation  %9.1f ms  %zu triangles, %zu outline faces\n",
               st.tessellateMs, st.triangles, st.outlineFaces);
-  std::printf("  BVH (medium)        %9.1f ms\n", st.bvhMs);
+  std::printf("  BVH (high)          %9.1f ms\n", st.bvhMs);
   std::printf("  primary rays        %9.1f ms  %d rays (packets of 16)\n", st.traceMs, size * size);
   std::printf("  Newton + shading    %9.1f ms  %zu hits, %zu not refined\n", st.newtonMs, st.hits,
               st.newtonFailures);
