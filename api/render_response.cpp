@@ -118,6 +118,7 @@ void writeStats(Writer& w, const render::pipeline::Stats& s) {
   w.Uint64(s.referenceTriangles);
   if (s.referenceCrossCheckPx) {
     numberField(w, "referenceCrossCheckPx", *s.referenceCrossCheckPx);
+    numberField(w, "referenceCrossCheckMeanPx", s.referenceCrossCheckMeanPx.value_or(0.0));
   }
   w.EndObject();
 }

@@ -61,7 +61,9 @@ struct Stats {
   size_t referenceTriangles = 0;
   // Silhouette Hausdorff distance (output pixels) between the two reference paths
   // (dense tessellation + Newton vs. Embree's subdivision geometry); absent when not computed.
+  // Quantised to 1/metricSupersample: a single differing supersampled pixel reads 1/S.
   std::optional<double> referenceCrossCheckPx;
+  std::optional<double> referenceCrossCheckMeanPx;  // mean outline distance of the same pair
 };
 
 struct Timings {

@@ -154,9 +154,15 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       std::optional<Image> embreeMask =
           oracle::embreeSubdivisionMask(surface, camera.scaled(S), cancel, &whyNot);
       if (embreeMask) {
-        result.stats.referenceCrossCheckPx =
-            metrics::compareSilhouettes(*embreeMask, reference.images.supersampledMask, S)
-                .hausdorffPx;
+        metrics::SilhouetteMetrics agreement =
+            metrics::compareSilhouettes(*embreeMask, reference.images.supersampledMask, S);
+        result.stats.referenceCrossCheckPx = agreement.hausdorffPx;
+        result.stats.referenceCrossCheckMeanPx = agreement.meanPx;
+        if (agreement.hausdorffPx > 1.0) {
+          result.warnings.push_back(
+              "the two reference paths disagree: Embree's subdivision geometry is " +
+              std::to_string(agreement.hausdorffPx) + " px from the tessellated reference");
+        }
       } else {
         result.warnings.push_back("reference cross-check skipped: " + whyNot);
       }

@@ -5,7 +5,7 @@
 //    smallest rate.
 // 2. Every edge gets one rate: the largest its faces ask for, a face asking for its edge's
 //    projected length (along the limit curve's corner-midpoint-corner polyline) divided by the
-//    dicing rate and scaled by the face's density.
+//    dicing rate; callers may raise any edge's count (AdaptiveOptions::minSegments).
 // 3. Faces are tessellated independently (Bfr::Tessellation with those edge rates) and
 //    evaluated in parallel.
 // 4. Assembly shares the points of each edge between its faces, so the mesh is watertight by
@@ -179,12 +179,11 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
   std::vector<int> edgeRate(base.GetNumEdges(), options.minEdgeRate);
   for (int f = 0; f < faceCount; ++f) {
     if (!surface.hasLimit(f)) continue;
-    double density = options.density ? options.density(f) : 1.0;
     Far::ConstIndexArray edges = base.GetFaceEdges(f);
     for (int k = 0; k < edges.size(); ++k) {
       int rate = options.minEdgeRate;
       if (!probes[f].culled) {
-        double segments = std::ceil(probes[f].edgePixels[k] * density / options.dicingRate);
+        double segments = std::ceil(probes[f].edgePixels[k] / options.dicingRate);
         rate = static_cast<int>(std::clamp(segments, static_cast<double>(options.minEdgeRate),
                                            static_cast<double>(options.maxEdgeRate)));
       }

@@ -26,9 +26,6 @@ struct AdaptiveOptions {
   int maxEdgeRate = 128;    // segments per edge at most
   int minEdgeRate = 1;      // used for faces outside the view or facing away
   size_t maxTriangles = 8'000'000;
-  // Optional per-face density: the target edge length for face f is dicingRate / density(f).
-  // The reference uses it to tessellate faces near the silhouette more finely.
-  std::function<double(int face)> density;
   // Optional lower bound on the segments of base-level edge e (then capped by maxEdgeRate),
   // applied whether or not its faces are culled. Projected lengths are foreshortened where the
   // surface turns away at the silhouette; the reference bounds those edges by their 3D length.
