@@ -86,12 +86,13 @@ void Framebuffer::read(int attachment, GLenum format, std::vector<float>& out) c
   checkGl("reading back a framebuffer attachment");
 }
 
-void Framebuffer::readRedBytes(int attachment, std::vector<unsigned char>& out) const {
-  out.resize(static_cast<size_t>(width_) * height_);
+void Framebuffer::readBytes(int attachment, GLenum format, std::vector<unsigned char>& out) const {
+  const size_t components = format == GL_RGBA ? 4 : 1;
+  out.resize(static_cast<size_t>(width_) * height_ * components);
   glNamedFramebufferReadBuffer(framebuffer_, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
   glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadnPixels(0, 0, width_, height_, GL_RED, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()),
+  glReadnPixels(0, 0, width_, height_, format, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()),
                 out.data());
   checkGl("reading back a framebuffer attachment");
 }

@@ -31,7 +31,11 @@ class Framebuffer {
   void read(int attachment, GLenum format, std::vector<float>& out) const;
   // Reads the red channel of an 8-bit attachment as bytes (4 times less to convert and copy
   // than floats, which matters for the large supersampled coverage).
-  void readRedBytes(int attachment, std::vector<unsigned char>& out) const;
+  void readRedBytes(int attachment, std::vector<unsigned char>& out) const {
+    readBytes(attachment, GL_RED, out);
+  }
+  // Reads an 8-bit attachment as bytes, GL_RED (1 per pixel) or GL_RGBA (4 per pixel).
+  void readBytes(int attachment, GLenum format, std::vector<unsigned char>& out) const;
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -11,6 +11,7 @@
 #include "render/raster/gl_api.h"
 #include "render/raster/gl_error.h"
 #include "render/raster/mesh_buffers.h"
+#include "render/raster/overlay_buffers.h"
 #include "render/raster/shader_program.h"
 #include "render/raster/shaders.h"
 #include "render/raster/tiling.h"
@@ -19,13 +20,28 @@ namespace limn::render::raster {
 
 namespace {
 
-// Largest tile of each framebuffer, besides the GL limits: the frame pass holds 40 bytes per
-// pixel (2048^2: 160 MiB), the coverage pass 1 byte per pixel (4096^2: 16 MiB).
+// Largest tile of each framebuffer, besides the GL limits: the frame pass holds 44 bytes per
+// pixel (2048^2: 176 MiB), the coverage pass 1 byte per pixel (4096^2: 16 MiB).
 constexpr int kFrameTileCap = 2048;
 constexpr int kCoverageTileCap = 4096;
 
 // Attachments of the frame pass; fragment output i writes attachment i.
-enum FrameAttachment { kColorAttachment = 0, kDepthAttachment = 1, kNormalAttachment = 2 };
+enum FrameAttachment {
+  kColorAttachment = 0,
+  kDepthAttachment = 1,
+  kNormalAttachment = 2,
+  kOverlayAttachment = 3,  // one overlay's lines at a time, RGBA8, transparent where none
+};
+
+// Overlay lines are 2 px wide, and moved 1 px (the world size of one pixel at their depth)
+// towards the eye, so lines on a surface, or on the limit surface a little behind its
+// tessellation, are not hidden by it.
+constexpr float kOverlayHalfWidthPx = 1.0f;
+constexpr double kOverlayBiasPx = 1.0;
+// Polygon offset of the surface when edges or lines are drawn over it, in units of its depth
+// slope per pixel: lines lying on a surface still pass the depth test a line half-width
+// (1 px, up to sqrt(2) times the slope diagonally) to either side of their centre.
+constexpr float kSurfaceOffset = -2.0f;
 
 std::string glString(GLenum name) {
   const GLubyte* text = glGetString(name);
@@ -61,6 +77,24 @@ void copyComponents(const float* from, float* to) {
   std::copy(from, from + N, to);
 }
 
+// Composites a tile of overlay lines (RGBA bytes) over the colour tile (RGBA floats), both
+// bottom row first, into `dst`: "over" with the line's alpha; exactly the colour where no line.
+void placeOverlayTile(const std::vector<float>& color, const std::vector<unsigned char>& lines,
+                      const Tile& tile, Image& dst) {
+  for (int r = 0; r < tile.height; ++r) {
+    const int dstRow = tile.y + tile.height - 1 - r;
+    for (int i = 0; i < tile.width; ++i) {
+      const size_t at = (static_cast<size_t>(r) * tile.width + i) * 4;
+      const float* c = &color[at];
+      const unsigned char* line = &lines[at];
+      float* to = &dst.at(tile.x + i, dstRow, 0);
+      const float a = line[3] / 255.0f;
+      for (int k = 0; k < 3; ++k) to[k] = a * (line[k] / 255.0f) + (1.0f - a) * c[k];
+      to[3] = a + (1.0f - a) * c[3];
+    }
+  }
+}
+
 }  // namespace
 
 struct Rasterizer::Impl {
@@ -68,18 +102,23 @@ struct Rasterizer::Impl {
   DeviceInfo device;
   ShaderProgram surfaceProgram{"surface", surfaceVertexShader(), surfaceFragmentShader()};
   ShaderProgram solidProgram{"solid", solidVertexShader(), solidFragmentShader()};
+  ShaderProgram lineProgram{"line", lineVertexShader(), lineFragmentShader(),
+                            lineGeometryShader()};
   MeshBuffers mesh;
-  Framebuffer frame{{GL_RGBA32F, GL_R32F, GL_RGBA32F}, /*withDepth=*/true};
+  OverlayBuffers overlayLines;
+  Framebuffer frame{{GL_RGBA32F, GL_R32F, GL_RGBA32F, GL_RGBA8}, /*withDepth=*/true};
   Framebuffer coverage{{GL_R8}, /*withDepth=*/false};
   int frameTileSize = 0;
   int coverageTileSize = 0;
   std::vector<float> readback;
+  std::vector<float> colorReadback;  // kept while overlays are drawn over it
   std::vector<unsigned char> readbackBytes;
 
   Impl();
   ~Impl();
   void renderFrame(const Camera& camera, const PassSelection& passes, Shading shading,
-                   ImageSet& out);
+                   const std::vector<LineOverlay>& overlays, ImageSet& out);
+  void setLineUniforms(const Camera& camera);
   void renderCoverage(const Camera& camera, int supersample, ImageSet& out);
 };
 
@@ -112,16 +151,37 @@ Rasterizer::Impl::~Impl() {
   }
 }
 
+void Rasterizer::Impl::setLineUniforms(const Camera& camera) {
+  const bool perspective = camera.projection() == Projection::Perspective;
+  const Vec3f eye(camera.eye()), forward(camera.forward());
+  // Perspective: the world size of a pixel is depth / pixelsPerUnit(1), and a point moved by
+  // that fraction of its distance to the eye moves at least that far along its ray.
+  const double bias = perspective ? kOverlayBiasPx / camera.pixelsPerUnit(1.0)
+                                  : kOverlayBiasPx / camera.pixelsPerUnit(0.0);
+  lineProgram.setVec3("uEye", eye.x, eye.y, eye.z);
+  lineProgram.setVec3("uForward", forward.x, forward.y, forward.z);
+  lineProgram.setBool("uPerspective", perspective);
+  lineProgram.setFloat("uBias", static_cast<float>(bias));
+  lineProgram.setFloat("uHalfWidth", kOverlayHalfWidthPx);
+}
+
 void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& passes,
-                                   Shading shading, ImageSet& out) {
+                                   Shading shading, const std::vector<LineOverlay>& overlays,
+                                   ImageSet& out) {
   const int width = camera.width(), height = camera.height();
-  const bool colorBuffer = passes.color || passes.mask || passes.wireframe;
+  const bool colorBuffer = passes.color || passes.mask || passes.wireframe || !overlays.empty();
   Image color, mask, depth, normal, wireframe;
   if (passes.color) color = Image(width, height, 4);
   if (passes.mask) mask = Image(width, height, 1);
   if (passes.depth) depth = Image(width, height, 1);
   if (passes.normal) normal = Image(width, height, 3);
   if (passes.wireframe) wireframe = Image(width, height, 4);
+  std::vector<Image> overlayImages(overlays.size());
+  for (Image& image : overlayImages) image = Image(width, height, 4);
+  const bool offsetSurface =
+      passes.wireframe || std::any_of(overlays.begin(), overlays.end(),
+                                      [](const LineOverlay& o) { return o.occluded; });
+  if (!overlays.empty()) setLineUniforms(camera);
 
   const Mat4 viewProjection = multiply(camera.projectionMatrix(), camera.viewMatrix());
   const Vec3f eye(camera.eye()), forward(camera.forward());
@@ -148,11 +208,11 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
-    if (passes.wireframe) {
+    if (offsetSurface) {
       // Push the surface back a little so edges lying on it pass the depth test, while edges
       // behind other surfaces still fail it.
       glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(-1.0f, -1.0f);
+      glPolygonOffset(kSurfaceOffset, kSurfaceOffset);
     }
     surfaceProgram.use();
     surfaceProgram.setMatrix("uViewProjection", tileViewProjection);
@@ -161,10 +221,10 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
     checkGl("drawing the surface");
 
     if (colorBuffer) {
-      frame.read(kColorAttachment, GL_RGBA, readback);
-      if (passes.color) placeTile(readback, 4, tile, color, copyComponents<4>);
+      frame.read(kColorAttachment, GL_RGBA, colorReadback);
+      if (passes.color) placeTile(colorReadback, 4, tile, color, copyComponents<4>);
       if (passes.mask) {
-        placeTile(readback, 4, tile, mask,
+        placeTile(colorReadback, 4, tile, mask,
                   [](const float* from, float* to) { *to = from[3] > 0.5f ? 1.0f : 0.0f; });
       }
     }
@@ -175,6 +235,31 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
     if (passes.normal) {
       frame.read(kNormalAttachment, GL_RGBA, readback);
       placeTile(readback, 4, tile, normal, copyComponents<3>);
+    }
+
+    if (!overlays.empty()) {
+      lineProgram.use();
+      lineProgram.setMatrix("uViewProjection", tileViewProjection);
+      lineProgram.setVec2("uViewport", static_cast<float>(tile.width),
+                          static_cast<float>(tile.height));
+      glDepthMask(GL_FALSE);
+      glDepthFunc(GL_GEQUAL);
+      const float transparent[4] = {0, 0, 0, 0};
+      for (size_t k = 0; k < overlays.size(); ++k) {
+        frame.setDrawBuffers({false, false, false, true});
+        frame.clearColor(kOverlayAttachment, transparent);
+        if (overlays[k].occluded) {
+          glEnable(GL_DEPTH_TEST);
+        } else {
+          glDisable(GL_DEPTH_TEST);
+        }
+        overlayLines.draw(k);
+        checkGl("drawing an overlay");
+        frame.readBytes(kOverlayAttachment, GL_RGBA, readbackBytes);
+        placeOverlayTile(colorReadback, readbackBytes, tile, overlayImages[k]);
+      }
+      glEnable(GL_DEPTH_TEST);
+      glDepthMask(GL_TRUE);
     }
 
     if (passes.wireframe) {
@@ -196,6 +281,9 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
   if (passes.depth) out.passes[pass::kDepth] = std::move(depth);
   if (passes.normal) out.passes[pass::kNormal] = std::move(normal);
   if (passes.wireframe) out.passes[pass::kWireframe] = std::move(wireframe);
+  for (size_t k = 0; k < overlays.size(); ++k) {
+    out.passes[overlays[k].pass] = std::move(overlayImages[k]);
+  }
 }
 
 void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample, ImageSet& out) {
@@ -232,21 +320,24 @@ Rasterizer::~Rasterizer() = default;
 const DeviceInfo& Rasterizer::device() const { return impl_->device; }
 
 ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& camera,
-                            const PassSelection& passes, Shading shading) {
+                            const PassSelection& passes, Shading shading,
+                            const std::vector<LineOverlay>& overlays) {
   if (camera.width() <= 0 || camera.height() <= 0) {
     throw std::invalid_argument("raster: the camera's image size must be positive");
   }
   if (passes.supersample < 0) {
     throw std::invalid_argument("raster: the supersample factor must not be negative");
   }
+  validateOverlays(overlays);
   impl_->context.makeCurrent();
   ImageSet result;
-  const bool frame =
-      passes.color || passes.mask || passes.depth || passes.normal || passes.wireframe;
+  const bool frame = passes.color || passes.mask || passes.depth || passes.normal ||
+                     passes.wireframe || !overlays.empty();
   if (!frame && passes.supersample == 0) return result;
 
   impl_->mesh.upload(mesh);
-  if (frame) impl_->renderFrame(camera, passes, shading, result);
+  if (!overlays.empty()) impl_->overlayLines.upload(overlays);
+  if (frame) impl_->renderFrame(camera, passes, shading, overlays, result);
   if (passes.supersample > 0) impl_->renderCoverage(camera, passes.supersample, result);
   return result;
 }

@@ -10,17 +10,25 @@
 // at the top. Geometry outside the camera's near/far planes is clipped. Colour follows
 // shading::shade() (back faces get the back albedo); the normal pass holds the shading normal
 // as computed (not flipped for back faces); depth is linear (Camera::depthOf), 0 where empty.
+// Line overlays (render/core/overlay.h) each make one more pass: the colour image with the
+// overlay's segments drawn over it, 2 px wide with square ends, composited with their alpha.
+// Occluded overlays are depth-tested against the surface with a bias (lines are moved 1 px
+// towards the eye, the surface pushed back by twice its depth slope), so lines lying on it
+// stay visible; the others are drawn over everything.
 // Frames larger than the GL limits, and supersampled masks, are drawn in tiles with the same
 // sample positions. Shaders and GL objects are made once and reused; a mesh without normals is
 // shaded flat. Bad input (indices out of range, normals not one per vertex, an empty image
-// size) throws std::invalid_argument; GL failures throw std::runtime_error naming the step.
+// size, a malformed overlay: see validateOverlays in overlay_buffers.h) throws
+// std::invalid_argument; GL failures throw std::runtime_error naming the step.
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "render/core/camera.h"
 #include "render/core/image.h"
+#include "render/core/overlay.h"
 #include "render/core/passes.h"
 #include "render/tessellate/triangle_mesh.h"
 
@@ -43,9 +51,11 @@ class Rasterizer {
   const DeviceInfo& device() const;
 
   // Draws `mesh` for `camera` and returns the selected passes at the camera's size, plus the
-  // supersampled coverage mask when passes.supersample > 0. Shading follows render/core/shading.h.
+  // supersampled coverage mask when passes.supersample > 0, plus one pass per overlay, named
+  // overlay.pass. Shading follows render/core/shading.h.
   ImageSet render(const tessellate::TriangleMesh& mesh, const Camera& camera,
-                  const PassSelection& passes, Shading shading);
+                  const PassSelection& passes, Shading shading,
+                  const std::vector<LineOverlay>& overlays = {});
 
  private:
   struct Impl;

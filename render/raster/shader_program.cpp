@@ -42,22 +42,32 @@ GLuint compile(GLenum stage, const std::string& source, const std::string& what)
 }  // namespace
 
 ShaderProgram::ShaderProgram(const std::string& name, const std::string& vertexSource,
-                             const std::string& fragmentSource) {
-  GLuint vertex = compile(GL_VERTEX_SHADER, vertexSource, name + " vertex shader");
-  GLuint fragment = 0;
+                             const std::string& fragmentSource,
+                             const std::string& geometrySource) {
+  struct Stage {
+    GLenum type;
+    const std::string* source;
+    const char* what;
+  };
+  std::vector<Stage> stages = {{GL_VERTEX_SHADER, &vertexSource, " vertex shader"},
+                               {GL_FRAGMENT_SHADER, &fragmentSource, " fragment shader"}};
+  if (!geometrySource.empty()) {
+    stages.push_back({GL_GEOMETRY_SHADER, &geometrySource, " geometry shader"});
+  }
+  std::vector<GLuint> shaders;
   try {
-    fragment = compile(GL_FRAGMENT_SHADER, fragmentSource, name + " fragment shader");
+    for (const Stage& stage : stages) {
+      shaders.push_back(compile(stage.type, *stage.source, name + stage.what));
+    }
   } catch (...) {
-    glDeleteShader(vertex);
+    for (GLuint shader : shaders) glDeleteShader(shader);
     throw;
   }
   program_ = glCreateProgram();
-  glAttachShader(program_, vertex);
-  glAttachShader(program_, fragment);
+  for (GLuint shader : shaders) glAttachShader(program_, shader);
   glLinkProgram(program_);
   // The program keeps what it needs; the shader objects can go now.
-  glDeleteShader(vertex);
-  glDeleteShader(fragment);
+  for (GLuint shader : shaders) glDeleteShader(shader);
   GLint ok = GL_FALSE;
   glGetProgramiv(program_, GL_LINK_STATUS, &ok);
   if (!ok) {
@@ -83,6 +93,18 @@ void ShaderProgram::setVec4(const char* uniform, const float rgba[4]) const {
 
 void ShaderProgram::setBool(const char* uniform, bool value) const {
   glProgramUniform1i(program_, location(uniform), value ? 1 : 0);
+}
+
+void ShaderProgram::setInt(const char* uniform, int value) const {
+  glProgramUniform1i(program_, location(uniform), value);
+}
+
+void ShaderProgram::setFloat(const char* uniform, float value) const {
+  glProgramUniform1f(program_, location(uniform), value);
+}
+
+void ShaderProgram::setVec2(const char* uniform, float x, float y) const {
+  glProgramUniform2f(program_, location(uniform), x, y);
 }
 
 }  // namespace limn::render::raster

@@ -1,4 +1,4 @@
-// ShaderProgram: a linked GLSL program (vertex + fragment) owned by one context. Compile and
+// ShaderProgram: a linked GLSL program (vertex, optional geometry, fragment) owned by one context. Compile and
 // link errors become std::runtime_error with the driver's log. Uniforms are set through the
 // direct-state-access calls, so the program need not be bound to be configured.
 #pragma once
@@ -12,8 +12,9 @@ namespace limn::render::raster {
 
 class ShaderProgram {
  public:
+  // An empty geometrySource means no geometry stage.
   ShaderProgram(const std::string& name, const std::string& vertexSource,
-                const std::string& fragmentSource);
+                const std::string& fragmentSource, const std::string& geometrySource = "");
   ~ShaderProgram();
   ShaderProgram(const ShaderProgram&) = delete;
   ShaderProgram& operator=(const ShaderProgram&) = delete;
@@ -25,6 +26,9 @@ class ShaderProgram {
   void setVec3(const char* uniform, float x, float y, float z) const;
   void setVec4(const char* uniform, const float rgba[4]) const;
   void setBool(const char* uniform, bool value) const;
+  void setInt(const char* uniform, int value) const;
+  void setFloat(const char* uniform, float value) const;
+  void setVec2(const char* uniform, float x, float y) const;
 
  private:
   GLint location(const char* uniform) const { return glGetUniformLocation(program_, uniform); }

@@ -107,4 +107,70 @@ void main() { oColor = uColor; }
 )";
 }
 
+std::string lineVertexShader() {
+  return R"(#version 450 core
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec4 aColor;
+uniform mat4 uViewProjection;
+uniform vec3 uEye;
+uniform vec3 uForward;
+uniform bool uPerspective;
+uniform float uBias;
+out vec4 vColor;
+void main() {
+  // Towards the eye along the view ray: the point stays on its pixel, only its depth changes.
+  vec3 p = uPerspective ? uEye + (aPosition - uEye) * (1.0 - uBias) : aPosition - uForward * uBias;
+  vColor = aColor;
+  gl_Position = uViewProjection * vec4(p, 1.0);
+}
+)";
+}
+
+std::string lineGeometryShader() {
+  return R"(#version 450 core
+layout(lines) in;
+layout(triangle_strip, max_vertices = 4) out;
+in vec4 vColor[];
+flat out vec4 gColor;
+uniform vec2 uViewport;
+uniform float uHalfWidth;
+
+// Clip-space offset of `pixels` at a vertex with this w.
+vec4 offset(vec2 pixels, float w) { return vec4(pixels / (0.5 * uViewport) * w, 0.0, 0.0); }
+
+void main() {
+  vec4 a = gl_in[0].gl_Position;
+  vec4 b = gl_in[1].gl_Position;
+  // Cut the segment at the near plane (reversed depth: z <= w in front of it) before dividing
+  // by w, which is not positive behind the eye.
+  float da = a.w - a.z, db = b.w - b.z;
+  if (da < 0.0 && db < 0.0) return;
+  if (da < 0.0) a = mix(a, b, da / (da - db));
+  if (db < 0.0) b = mix(b, a, db / (db - da));
+
+  vec2 sa = a.xy / a.w * 0.5 * uViewport;
+  vec2 sb = b.xy / b.w * 0.5 * uViewport;
+  vec2 along = sb - sa;
+  float len = length(along);
+  along = len > 1e-6 ? along / len : vec2(1.0, 0.0);  // seen end-on: a square
+  vec2 side = vec2(-along.y, along.x) * uHalfWidth;
+  along *= uHalfWidth;
+  gColor = vColor[0];
+  gl_Position = a + offset(-along - side, a.w); EmitVertex();
+  gl_Position = a + offset(-along + side, a.w); EmitVertex();
+  gl_Position = b + offset(along - side, b.w); EmitVertex();
+  gl_Position = b + offset(along + side, b.w); EmitVertex();
+  EndPrimitive();
+}
+)";
+}
+
+std::string lineFragmentShader() {
+  return R"(#version 450 core
+flat in vec4 gColor;
+layout(location = 3) out vec4 oOverlay;
+void main() { oOverlay = gColor; }
+)";
+}
+
 }  // namespace limn::render::raster

@@ -1,4 +1,4 @@
-// GLSL sources of the rasteriser's two programs. The shading constants are generated from
+// GLSL sources of the rasteriser's programs. The shading constants are generated from
 // render/core/shading.h, so the fragment shader and shading::shade() cannot drift apart.
 #pragma once
 
@@ -16,6 +16,17 @@ std::string surfaceFragmentShader();
 // Uniform: uViewProjection.
 std::string solidVertexShader();
 std::string solidFragmentShader();
+
+// The line program: overlay segments widened into screen-space quads (OpenGL core has no wide
+// lines) by a geometry shader, each written with its segment's RGBA at location 3.
+// Attributes: aPosition (0), aColor (1, normalised bytes). Uniforms: uViewProjection, uViewport
+// (the tile's size in pixels), uHalfWidth (pixels; the quad is 2 * uHalfWidth wide and extends
+// uHalfWidth past each end so polylines have no gaps at their joints), and uEye, uForward,
+// uPerspective, uBias: each point is moved towards the eye along its view ray before projection,
+// by the fraction uBias of its distance (perspective) or uBias world units (orthographic).
+std::string lineVertexShader();
+std::string lineGeometryShader();
+std::string lineFragmentShader();
 
 // A float as a GLSL literal that reads back to the same float ("0.800000012", "40.0").
 std::string glslFloat(float value);

@@ -1,10 +1,13 @@
 // Tests of render/raster: the headless EGL/OpenGL rasteriser against what the camera and the
 // shading model say each pixel must hold (coverage from Camera::project, linear depth, normals,
-// shading::shade colours, supersampled coverage, tiles, wireframe, threads).
+// shading::shade colours, supersampled coverage, tiles, wireframe, line overlays, threads).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cstdint>
+#include <limits>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -13,6 +16,7 @@
 #include <vector>
 
 #include "render/core/camera.h"
+#include "render/core/overlay.h"
 #include "render/core/shading.h"
 #include "render/raster/rasterizer.h"
 #include "render/raster/shaders.h"
@@ -615,6 +619,394 @@ TEST_F(RasterTest, MillionsOfTriangles) {
   // The grid is larger than the view: every pixel covered at depth 3, no cracks.
   for (float v : images.passes[pass::kMask].pixels) ASSERT_EQ(v, 1.0f);
   for (float v : images.passes[pass::kDepth].pixels) ASSERT_NEAR(v, 3.0f, 1e-5f);
+}
+
+// ---- Line overlays ----
+
+using Rgba = std::array<uint8_t, 4>;
+
+// An overlay segment projected to pixel coordinates, with its colour.
+struct PixelSegment {
+  Vec3 a, b;
+  Rgba color;
+};
+
+std::vector<PixelSegment> projectOverlay(const Camera& camera, const LineOverlay& overlay) {
+  std::vector<PixelSegment> out;
+  for (size_t s = 0; s < overlay.segmentCount(); ++s) {
+    out.push_back({camera.project(overlay.points[2 * s].toDouble()),
+                   camera.project(overlay.points[2 * s + 1].toDouble()), overlay.colors[s]});
+  }
+  return out;
+}
+
+// The segment nearest to the pixel centre (x + 0.5, y + 0.5) and its distance.
+const PixelSegment* nearestSegment(const std::vector<PixelSegment>& segments, int x, int y,
+                                   double& distance) {
+  const PixelSegment* best = nullptr;
+  distance = 1e300;
+  for (const PixelSegment& s : segments) {
+    double d = segmentDistance(s.a, s.b, x + 0.5, y + 0.5);
+    if (d < distance) {
+      distance = d;
+      best = &s;
+    }
+  }
+  return best;
+}
+
+bool pixelHasColor(const Image& image, int x, int y, const Rgba& rgba) {
+  for (int k = 0; k < 4; ++k) {
+    if (image.at(x, y, k) != rgba[k] / 255.0f) return false;
+  }
+  return true;
+}
+
+bool samePixel(const Image& a, const Image& b, int x, int y) {
+  for (int k = 0; k < 4; ++k) {
+    if (a.at(x, y, k) != b.at(x, y, k)) return false;
+  }
+  return true;
+}
+
+// Checks an overlay pass against the colour pass: pixel centres within `onLine` px of a
+// segment hold its colour (when `visible` says they should), pixel centres farther than 1.5 px
+// from every segment (the quads' corners are sqrt(2) px away) equal the colour pass exactly.
+// Returns the number of line-coloured pixels.
+template <typename Visible>
+int expectOverlayPass(const Image& color, const Image& lines, const Camera& camera,
+                      const std::vector<PixelSegment>& segments, Visible visible,
+                      double onLine = 0.5) {
+  EXPECT_EQ(lines.width, camera.width());
+  EXPECT_EQ(lines.height, camera.height());
+  EXPECT_EQ(lines.channels, 4);
+  int drawn = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      double d = 0;
+      const PixelSegment* s = nearestSegment(segments, x, y, d);
+      if (d > 1.5) {
+        EXPECT_TRUE(samePixel(color, lines, x, y)) << "pixel " << x << ", " << y;
+        continue;
+      }
+      // Where segments cross, the pixel may hold the other one's colour.
+      bool lineColored = false;
+      for (const PixelSegment& other : segments) {
+        lineColored = lineColored ||
+                      (segmentDistance(other.a, other.b, x + 0.5, y + 0.5) <= 1.5 &&
+                       pixelHasColor(lines, x, y, other.color));
+      }
+      drawn += lineColored;
+      if (d < onLine && visible(x, y, *s)) {
+        EXPECT_TRUE(lineColored) << "pixel " << x << ", " << y << " at " << d << " px";
+      }
+    }
+  }
+  return drawn;
+}
+
+Camera sphereCamera(int width = 160, int height = 120) {
+  return Camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 2.0, width,
+                height, 1.0, 10.0);
+}
+
+PassSelection colorAndMask() {
+  PassSelection passes;
+  passes.color = passes.mask = true;
+  return passes;
+}
+
+TEST_F(RasterTest, OverlayLinesInFrontOfASphere) {
+  const TriangleMesh mesh = sphere(1.0, 48, 64);
+  const Camera camera = sphereCamera();
+  LineOverlay overlay;
+  overlay.pass = "lines";
+  // A horizontal line in front of the sphere across the whole frame, and a slanted one.
+  overlay.points = {Vec3f(-3, 0.1f, 1.3f), Vec3f(3, 0.1f, 1.3f), Vec3f(-0.3f, -2, 1.2f),
+                    Vec3f(0.2f, 2, 1.1f)};
+  overlay.colors = {Rgba{250, 10, 20, 255}, Rgba{0, 200, 40, 255}};
+  ImageSet images = rasterizer().render(mesh, camera, colorAndMask(), Shading::Smooth, {overlay});
+  ASSERT_EQ(images.passes.size(), 3u);
+  const Image& color = images.passes.at(pass::kColor);
+  const Image& lines = images.passes.at("lines");
+  const Image& mask = images.passes.at(pass::kMask);
+  const std::vector<PixelSegment> segments = projectOverlay(camera, overlay);
+  int overSphere = 0;
+  expectOverlayPass(color, lines, camera, segments, [&](int x, int y, const PixelSegment&) {
+    overSphere += mask.at(x, y) > 0;
+    return true;
+  });
+  EXPECT_GT(overSphere, 100);  // the lines really cross the sphere
+  // About 2 px wide: a horizontal line covers two pixel centres per column.
+  int red = 0;
+  for (int y = 0; y < camera.height(); ++y)
+    for (int x = 0; x < camera.width(); ++x) red += pixelHasColor(lines, x, y, overlay.colors[0]);
+  EXPECT_GE(red, 2 * camera.width() - 8);  // less where the green line crosses
+  EXPECT_LE(red, 2 * camera.width());
+  // The colour pass itself has no line in it.
+  EXPECT_FALSE(pixelHasColor(color, 80, static_cast<int>(segments[0].a.y), overlay.colors[0]));
+}
+
+TEST_F(RasterTest, OccludedOverlayIsHiddenBehindTheSurface) {
+  const TriangleMesh mesh = sphere(1.0, 48, 64);
+  const Camera camera = sphereCamera();
+  LineOverlay behind;
+  behind.pass = "behind";
+  behind.points = {Vec3f(-0.4f, 0.2f, -1.3f), Vec3f(0.4f, -0.1f, -1.3f)};
+  behind.colors = {Rgba{255, 255, 0, 255}};
+  ImageSet images = rasterizer().render(mesh, camera, colorAndMask(), Shading::Smooth, {behind});
+  EXPECT_EQ(images.passes.at("behind").pixels, images.passes.at(pass::kColor).pixels);
+
+  // Drawn over everything, the same line shows.
+  behind.occluded = false;
+  images = rasterizer().render(mesh, camera, colorAndMask(), Shading::Smooth, {behind});
+  const std::vector<PixelSegment> segments = projectOverlay(camera, behind);
+  int drawn = expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("behind"), camera,
+                                segments, [](int, int, const PixelSegment&) { return true; });
+  const double length = std::hypot(segments[0].b.x - segments[0].a.x,
+                                   segments[0].b.y - segments[0].a.y);
+  EXPECT_GT(drawn, 1.8 * length);
+
+  // A line from behind the sphere out past its silhouette shows only outside it.
+  LineOverlay out;
+  out.pass = "out";
+  out.points = {Vec3f(0, 0, -1.3f), Vec3f(4, 0.5f, -1.3f)};
+  out.colors = {Rgba{255, 0, 255, 255}};
+  images = rasterizer().render(mesh, camera, colorAndMask(), Shading::Smooth, {out});
+  const Image& mask = images.passes.at(pass::kMask);
+  // Distance to the silhouette: the sphere's outline is a circle about the image centre.
+  const double radiusPx = std::tan(std::asin(0.25)) * camera.pixelsPerUnit(1.0);
+  int shown = 0, hidden = 0;
+  expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("out"), camera,
+                    projectOverlay(camera, out), [&](int x, int y, const PixelSegment& s) {
+                      const double r = std::hypot(x + 0.5 - 80, y + 0.5 - 60);
+                      if (std::fabs(r - radiusPx) < 2) return false;
+                      const bool lineColored = pixelHasColor(images.passes.at("out"), x, y, s.color);
+                      if (mask.at(x, y) > 0) {
+                        EXPECT_FALSE(lineColored) << x << ", " << y;
+                        ++hidden;
+                        return false;
+                      }
+                      ++shown;
+                      return true;
+                    });
+  EXPECT_GT(hidden, 30);
+  EXPECT_GT(shown, 30);
+}
+
+// The point of the tilted quad at bilinear coordinates (s, t).
+Vec3f quadPoint(double s, double t) {
+  return Vec3f((kQuad[0] * (1 - s) + kQuad[1] * s) * (1 - t) +
+               (kQuad[3] * (1 - s) + kQuad[2] * s) * t);
+}
+
+// True when every pixel within `radius` pixels of (x, y) is covered.
+bool coveredAround(const Image& mask, int x, int y, int radius) {
+  for (int v = y - radius; v <= y + radius; ++v)
+    for (int u = x - radius; u <= x + radius; ++u)
+      if (u < 0 || v < 0 || u >= mask.width || v >= mask.height || mask.at(u, v) == 0) return false;
+  return true;
+}
+
+TEST_F(RasterTest, OverlayLinesLyingOnTheSurfaceStayVisible) {
+  // On a plane: across the tilted quad, along its diagonal (a shared triangle edge) and along
+  // one of its outer edges, for both projections.
+  auto onQuad = quadPoint;
+  LineOverlay overlay;
+  overlay.pass = "on";
+  overlay.points = {onQuad(0.1, 0.2), onQuad(0.9, 0.7), Vec3f(kQuad[0]), Vec3f(kQuad[2]),
+                    Vec3f(kQuad[0]), Vec3f(kQuad[1])};
+  overlay.colors = {Rgba{255, 0, 0, 255}, Rgba{0, 0, 255, 255}, Rgba{0, 255, 0, 255}};
+  for (const Camera& camera : {perspectiveCamera(96, 72), orthographicCamera(96, 72)}) {
+    ImageSet images = rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat,
+                                          {overlay});
+    int drawn = expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("on"), camera,
+                                  projectOverlay(camera, overlay),
+                                  [](int, int, const PixelSegment&) { return true; });
+    EXPECT_GT(drawn, 150);
+  }
+
+  // On a curved mesh: the equator of a UV sphere runs along triangle edges. Seen from above,
+  // its front half is visible all along and its back half hidden.
+  const int rings = 48, segmentsPerRing = 64;
+  const TriangleMesh mesh = sphere(1.0, rings, segmentsPerRing);
+  const Camera camera({0, 2.5, 3}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 2.0, 160,
+                      120, 1.0, 10.0);
+  LineOverlay equator;
+  equator.pass = "equator";
+  const uint32_t first = (rings / 2) * (segmentsPerRing + 1);
+  for (int j = 0; j < segmentsPerRing; ++j) {
+    equator.points.push_back(mesh.positions[first + j]);
+    equator.points.push_back(mesh.positions[first + j + 1]);
+    equator.colors.push_back(Rgba{255, 255, 255, 255});
+  }
+  ImageSet images = rasterizer().render(mesh, camera, colorAndMask(), Shading::Smooth, {equator});
+  const Image& color = images.passes.at(pass::kColor);
+  const Image& lines = images.passes.at("equator");
+  std::vector<PixelSegment> front, back;
+  for (int j = 0; j < segmentsPerRing; ++j) {
+    Vec3 a = equator.points[2 * j].toDouble(), b = equator.points[2 * j + 1].toDouble();
+    Vec3 mid = (a + b) * 0.5;
+    double facing = dot(normalize(mid), normalize(camera.eye() - mid));
+    PixelSegment s{camera.project(a), camera.project(b), equator.colors[j]};
+    if (facing > 0.2) front.push_back(s);
+    if (facing < -0.2) back.push_back(s);
+  }
+  ASSERT_GT(front.size(), 10u);
+  ASSERT_GT(back.size(), 10u);
+  int frontChecked = 0, backChecked = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      double dFront = 0, dBack = 0;
+      nearestSegment(front, x, y, dFront);
+      nearestSegment(back, x, y, dBack);
+      if (dFront < 0.5 && dBack > 3) {
+        EXPECT_TRUE(pixelHasColor(lines, x, y, equator.colors[0])) << x << ", " << y;
+        ++frontChecked;
+      }
+      // Away from the outline: there the back half's 2 px reach past the silhouette.
+      if (dBack < 0.7 && dFront > 3 && coveredAround(images.passes.at(pass::kMask), x, y, 2)) {
+        EXPECT_TRUE(samePixel(color, lines, x, y)) << x << ", " << y;
+        ++backChecked;
+      }
+    }
+  }
+  EXPECT_GT(frontChecked, 80);
+  EXPECT_GT(backChecked, 80);
+}
+
+TEST_F(RasterTest, OverlaysAreSeparatePassesAndBlendWithTheirAlpha) {
+  const Camera camera = perspectiveCamera(96, 72);
+  LineOverlay a, b;
+  a.pass = "a";
+  a.points = {Vec3f(-1, 0, 1), Vec3f(1, 0.5f, 1)};
+  a.colors = {Rgba{255, 0, 0, 128}};
+  b.pass = "b";
+  b.points = {Vec3f(0, -1, 1), Vec3f(0.2f, 1, 1)};
+  b.colors = {Rgba{0, 0, 255, 255}};
+  // The colour pass is not asked for; the overlays still start from it.
+  PassSelection passes;
+  passes.depth = true;
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, passes, Shading::Flat, {a, b});
+  EXPECT_EQ(images.passes.size(), 3u);
+  EXPECT_EQ(images.find(pass::kColor), nullptr);
+  PassSelection colorOnly;
+  colorOnly.color = true;
+  const Image color =
+      rasterizer().render(tiltedQuad(), camera, colorOnly, Shading::Flat).passes.at(pass::kColor);
+  const std::vector<PixelSegment> segA = projectOverlay(camera, a), segB = projectOverlay(camera, b);
+  const float alpha = 128 / 255.0f;
+  int blended = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      double dA = 0, dB = 0;
+      nearestSegment(segA, x, y, dA);
+      nearestSegment(segB, x, y, dB);
+      // Each pass holds only its own overlay.
+      if (dA > 1.5) {
+        EXPECT_TRUE(samePixel(color, images.passes.at("a"), x, y)) << x << "," << y;
+      }
+      if (dB > 1.5) {
+        EXPECT_TRUE(samePixel(color, images.passes.at("b"), x, y)) << x << "," << y;
+      }
+      if (dA < 0.5) {
+        const Image& pa = images.passes.at("a");
+        EXPECT_NEAR(pa.at(x, y, 0), alpha + (1 - alpha) * color.at(x, y, 0), 1e-5);
+        EXPECT_NEAR(pa.at(x, y, 1), (1 - alpha) * color.at(x, y, 1), 1e-5);
+        EXPECT_NEAR(pa.at(x, y, 3), alpha + (1 - alpha) * color.at(x, y, 3), 1e-5);
+        ++blended;
+      }
+    }
+  }
+  EXPECT_GT(blended, 50);
+}
+
+TEST_F(RasterTest, OverlayCrossingTheNearPlaneIsCut) {
+  // From in front of the sphere to behind the eye (z = 4): only the part deeper than the near
+  // plane (depth 1, z <= 3) may be drawn, where Camera::project puts it.
+  const Camera camera = sphereCamera();
+  LineOverlay overlay;
+  overlay.pass = "near";
+  overlay.points = {Vec3f(0.1f, 0.05f, 1.5f), Vec3f(0.3f, 0.15f, 8)};
+  overlay.colors = {Rgba{0, 255, 255, 255}};
+  overlay.occluded = false;
+  ImageSet images = rasterizer().render(sphere(1.0, 24, 32), camera, colorAndMask(),
+                                        Shading::Smooth, {overlay});
+  // The visible part ends on the near plane: z = 3, at t = 1.5 / 6.5 along the segment.
+  const double t = 1.5 / 6.5;
+  LineOverlay visible = overlay;
+  visible.points[1] = Vec3f(0.1f + 0.2f * static_cast<float>(t),
+                            0.05f + 0.1f * static_cast<float>(t), 3.0f);
+  int drawn = expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("near"), camera,
+                                projectOverlay(camera, visible),
+                                [](int, int, const PixelSegment&) { return true; });
+  EXPECT_GT(drawn, 20);
+}
+
+TEST_F(RasterTest, OverlaysAreTiledLikeTheOtherPasses) {
+  // The frame of LargeFramesAndSupersampledMasksAreTiled: the quad straddles x = 2048.
+  Camera camera(Vec3{0.4 - 13.75, 0.3, 5}, Vec3{-13.75, 0.2, 0}, Vec3{0, 1, 0}, 10.0,
+                Projection::Perspective, 2.0, 2100, 50, 1.0, 10.0);
+  LineOverlay overlay;
+  overlay.pass = "seam";
+  overlay.points = {quadPoint(0.02, 0.3), quadPoint(0.98, 0.6)};
+  overlay.colors = {Rgba{255, 128, 0, 255}};
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat,
+                                        {overlay});
+  const std::vector<PixelSegment> segments = projectOverlay(camera, overlay);
+  ASSERT_LT(std::min(segments[0].a.x, segments[0].b.x), 2040);
+  ASSERT_GT(std::max(segments[0].a.x, segments[0].b.x), 2056);
+  const Image& lines = images.passes.at("seam");
+  int drawn = expectOverlayPass(images.passes.at(pass::kColor), lines, camera, segments,
+                                [](int, int, const PixelSegment&) { return true; });
+  EXPECT_GT(drawn, 100);
+  int atSeam = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    atSeam += pixelHasColor(lines, 2047, y, overlay.colors[0]) +
+              pixelHasColor(lines, 2048, y, overlay.colors[0]);
+  }
+  EXPECT_GE(atSeam, 2);
+}
+
+TEST_F(RasterTest, RejectsMalformedOverlays) {
+  const Camera camera = perspectiveCamera();
+  LineOverlay good;
+  good.pass = "cage";
+  good.points = {Vec3f(0, 0, 0), Vec3f(1, 0, 0)};
+  good.colors = {Rgba{1, 2, 3, 255}};
+  auto rejects = [&](const std::vector<LineOverlay>& overlays) {
+    EXPECT_THROW(rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat, overlays),
+                 std::invalid_argument);
+  };
+  LineOverlay bad = good;
+  bad.points.push_back(Vec3f(0, 1, 0));
+  rejects({bad});
+  bad = good;
+  bad.colors.push_back(Rgba{0, 0, 0, 255});
+  rejects({bad});
+  bad = good;
+  bad.pass.clear();
+  rejects({bad});
+  for (const char* builtIn : {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal,
+                              pass::kWireframe}) {
+    bad = good;
+    bad.pass = builtIn;
+    rejects({bad});
+  }
+  rejects({good, good});
+  bad = good;
+  bad.points[1].y = std::numeric_limits<float>::quiet_NaN();
+  rejects({bad});
+  // Even when no other pass is asked for.
+  EXPECT_THROW(rasterizer().render(tiltedQuad(), camera, PassSelection{}, Shading::Flat, {bad}),
+               std::invalid_argument);
+  // An overlay without segments is the colour pass; the rasteriser is still usable.
+  LineOverlay empty;
+  empty.pass = "empty";
+  ImageSet images = rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat,
+                                        {empty, good});
+  EXPECT_EQ(images.passes.at("empty").pixels, images.passes.at(pass::kColor).pixels);
+  EXPECT_EQ(images.passes.size(), 4u);
 }
 
 TEST(RasterThreads, TwoRasterizersOnTwoThreads) {
