@@ -1,0 +1,277 @@
+#include "render/silhouette/contour_search.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "render/core/parallel.h"
+#include "render/mesh/control_mesh.h"
+
+namespace limn::render::silhouette {
+
+namespace Far = OpenSubdiv::Far;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Corner normals this close to the vertex's shared normal are taken as the same normal, so
+// faces around a smooth vertex agree exactly on the sign of g there.
+constexpr double kSameNormalCos = 1.0 - 1e-10;
+
+int signOf(double g) { return g < 0 ? -1 : 1; }
+
+double angleBetween(const Vec3& a, const Vec3& b) {
+  double c = dot(normalize(a), normalize(b));
+  return std::acos(std::clamp(c, -1.0, 1.0));
+}
+
+// Where the edge sits in a face: its index among the face's edges and whether the face runs
+// along it from the edge's first vertex to its second.
+struct EdgeInFace {
+  int corner = -1;
+  bool forward = true;
+};
+
+EdgeInFace locateEdge(const Far::TopologyLevel& base, int face, int edge) {
+  Far::ConstIndexArray edges = base.GetFaceEdges(face);
+  Far::ConstIndexArray verts = base.GetFaceVertices(face);
+  for (int k = 0; k < edges.size(); ++k) {
+    if (edges[k] == edge) return {k, verts[k] == base.GetEdgeVertices(edge)[0]};
+  }
+  return {};
+}
+
+// g along one edge as seen from one face.
+class EdgeProbe {
+ public:
+  EdgeProbe(const subdiv::LimitSurface& surface, const Camera& camera, int face, int edge)
+      : surface_(surface), camera_(camera), face_(face) {
+    EdgeInFace where = locateEdge(surface.baseLevel(), face, edge);
+    int n = surface.mesh().faceVertexCounts[face];
+    Vec2 a = surface.cornerUV(face, where.corner);
+    Vec2 b = surface.cornerUV(face, (where.corner + 1) % n);
+    from_ = where.forward ? a : b;
+    to_ = where.forward ? b : a;
+  }
+
+  double g(double t) const {
+    subdiv::LimitSample s = surface_.evaluate(face_, from_.x + (to_.x - from_.x) * t,
+                                              from_.y + (to_.y - from_.y) * t);
+    return contourFunction(camera_, s.position, s.normal);
+  }
+  double slope(double t) const {
+    const double h = 1e-4;
+    double a = std::max(0.0, t - h), b = std::min(1.0, t + h);
+    return (g(b) - g(a)) / (b - a);
+  }
+
+ private:
+  const subdiv::LimitSurface& surface_;
+  const Camera& camera_;
+  int face_;
+  Vec2 from_, to_;
+};
+
+// Narrows a sign change of g in [a, b] by bisection, then interpolates linearly.
+double findCrossing(const EdgeProbe& probe, double a, double ga, double b, double gb,
+                    int steps) {
+  for (int i = 0; i < steps; ++i) {
+    double m = 0.5 * (a + b);
+    double gm = probe.g(m);
+    if (signOf(gm) == signOf(ga)) {
+      a = m;
+      ga = gm;
+    } else {
+      b = m;
+      gb = gm;
+    }
+  }
+  double denom = ga - gb;
+  return denom != 0 ? a + (b - a) * (ga / denom) : 0.5 * (a + b);
+}
+
+}  // namespace
+
+double contourFunction(const Camera& camera, const Vec3& position, const Vec3& normal) {
+  return dot(normal, camera.viewVector(position));
+}
+
+Vec2 edgeUV(const subdiv::LimitSurface& surface, int face, int edge, double t) {
+  EdgeInFace where = locateEdge(surface.baseLevel(), face, edge);
+  int n = surface.mesh().faceVertexCounts[face];
+  Vec2 a = surface.cornerUV(face, where.corner);
+  Vec2 b = surface.cornerUV(face, (where.corner + 1) % n);
+  if (!where.forward) std::swap(a, b);
+  return {a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t};
+}
+
+ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& camera,
+                            const SearchOptions& options, const CancelToken& cancel) {
+  const mesh::ControlMesh& cage = surface.mesh();
+  const Far::TopologyLevel& base = surface.baseLevel();
+  const std::vector<Vec3>& limitPositions = surface.controlLimitPositions();
+  const std::vector<Vec3>& limitNormals = surface.controlLimitNormals();
+  ContourSearch out;
+
+  // g at every face corner.
+  out.faceOffsets.resize(cage.faceCount() + 1, 0);
+  for (int f = 0; f < cage.faceCount(); ++f) {
+    out.faceOffsets[f + 1] = out.faceOffsets[f] + cage.faceVertexCounts[f];
+  }
+  out.cornerG.resize(cage.faceVertexIndices.size());
+  out.cornerNormals.resize(cage.faceVertexIndices.size());
+  parallelFor(cage.faceCount(), 64, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      for (size_t i = out.faceOffsets[f]; i < out.faceOffsets[f + 1]; ++i) {
+        int v = cage.faceVertexIndices[i];
+        Vec3 n = limitNormals[v];
+        if (surface.hasLimit(static_cast<int>(f))) {
+          Vec2 uv = surface.cornerUV(static_cast<int>(f), static_cast<int>(i - out.faceOffsets[f]));
+          Vec3 own = surface.evaluate(static_cast<int>(f), uv.x, uv.y).normal;
+          if (dot(own, n) < kSameNormalCos) n = own;
+        }
+        out.cornerNormals[i] = n;
+        out.cornerG[i] = contourFunction(camera, limitPositions[v], n);
+      }
+    }
+  });
+  cancel.check();
+
+  auto cornerIndex = [&](int face, int vertex) {
+    for (size_t i = out.faceOffsets[face]; i < out.faceOffsets[face + 1]; ++i) {
+      if (cage.faceVertexIndices[i] == vertex) return i;
+    }
+    return out.faceOffsets[face];
+  };
+
+  std::atomic<size_t> tested{0}, signChanges{0}, sampled{0}, doubles{0}, outlines{0};
+  out.edgePoints.resize(base.GetNumEdges());
+  parallelFor(base.GetNumEdges(), 64, [&](size_t begin, size_t end) {
+    std::vector<EdgePoint> found;
+    for (size_t e = begin; e < end; ++e) {
+      if ((e & 255) == 0) cancel.check();
+      Far::ConstIndexArray faces = base.GetEdgeFaces(static_cast<int>(e));
+      Far::ConstIndexArray ends = base.GetEdgeVertices(static_cast<int>(e));
+      int validFaces = 0;
+      uint32_t allSides = 0;
+      for (int k = 0; k < faces.size() && k < 32; ++k) {
+        if (!surface.hasLimit(faces[k])) continue;
+        ++validFaces;
+        allSides |= 1u << k;
+      }
+      if (validFaces == 0) continue;
+      ++tested;
+      const bool split = validFaces > 2 ||
+          (validFaces == 2 && base.GetEdgeSharpness(static_cast<int>(e)) >= mesh::kInfiniteSharpness);
+
+      found.clear();
+      bool signChange = false, wasSampled = false, sideSignsDiffer = false;
+      int firstSign[2] = {0, 0};
+      for (int k = 0; k < faces.size() && k < 32; ++k) {
+        if (!(allSides >> k & 1u)) continue;
+        const int face = faces[k];
+        size_t c0 = cornerIndex(face, ends[0]), c1 = cornerIndex(face, ends[1]);
+        double g0 = out.cornerG[c0], g1 = out.cornerG[c1];
+        EdgeProbe probe(surface, camera, face, static_cast<int>(e));
+        const uint32_t bits = split ? (1u << k) : allSides;
+
+        bool sample = signOf(g0) != signOf(g1);
+        signChange = signChange || sample;
+        if (firstSign[0] == 0) {
+          firstSign[0] = signOf(g0);
+          firstSign[1] = signOf(g1);
+        } else if (firstSign[0] != signOf(g0) || firstSign[1] != signOf(g1)) {
+          sideSignsDiffer = true;
+        }
+        const size_t foundBefore = found.size();
+        if (!sample) {
+          const Vec3& p0 = limitPositions[ends[0]];
+          const Vec3& p1 = limitPositions[ends[1]];
+          Vec3 v0 = camera.viewVector(p0), v1 = camera.viewVector(p1);
+          double phi0 = std::asin(std::min(1.0, std::fabs(g0) / std::max(length(v0), 1e-300)));
+          double phi1 = std::asin(std::min(1.0, std::fabs(g1) / std::max(length(v1), 1e-300)));
+          double turn = 1.5 * angleBetween(out.cornerNormals[c0], out.cornerNormals[c1]) +
+                        angleBetween(v0, v1) + kPi / 180.0;
+          sample = std::min(phi0, phi1) <= turn;
+        }
+        if (sample) {
+          wasSampled = true;
+          const int intervals = std::max(1, options.edgeSamples);
+          std::vector<double> ts(intervals + 1), gs(intervals + 1);
+          for (int i = 0; i <= intervals; ++i) {
+            ts[i] = static_cast<double>(i) / intervals;
+            gs[i] = i == 0 ? g0 : (i == intervals ? g1 : probe.g(ts[i]));
+          }
+          for (int i = 0; i < intervals; ++i) {
+            double a = ts[i], b = ts[i + 1];
+            if (signOf(gs[i]) != signOf(gs[i + 1])) {
+              found.push_back({findCrossing(probe, a, gs[i], b, gs[i + 1], options.searchSteps),
+                               {}, bits});
+              continue;
+            }
+            // Same sign at both ends: look for an extremum that reaches the other sign.
+            const int sign = signOf(gs[i]);
+            if (!(sign * probe.slope(a) < 0 && sign * probe.slope(b) > 0)) continue;
+            double lo = a, hi = b;
+            for (int step = 0; step < 12; ++step) {
+              double m = 0.5 * (lo + hi);
+              (sign * probe.slope(m) < 0 ? lo : hi) = m;
+            }
+            double tm = 0.5 * (lo + hi), gm = probe.g(tm);
+            if (signOf(gm) == sign) continue;
+            found.push_back({findCrossing(probe, a, gs[i], tm, gm, options.searchSteps), {}, bits});
+            found.push_back({findCrossing(probe, tm, gm, b, gs[i + 1], options.searchSteps), {}, bits});
+          }
+        }
+        if (signOf(g0) == signOf(g1) && found.size() > foundBefore) ++doubles;
+        if (!split) break;  // one face sees the whole edge
+      }
+      // Outline edges: shaped along their limit curve wherever they could show.
+      const bool outline = validFaces == 1 || (split && (sideSignsDiffer || !found.empty()));
+      if (outline) {
+        ++outlines;
+        const Vec3 a = camera.project(limitPositions[ends[0]]);
+        const Vec3 b = camera.project(limitPositions[ends[1]]);
+        double pixels = std::hypot(a.x - b.x, a.y - b.y);
+        int segments = std::clamp(static_cast<int>(std::ceil(pixels / options.pixelsPerSample)),
+                                  1, std::max(1, options.outlineSamples + 1));
+        for (int i = 1; i < segments; ++i) {
+          found.push_back({static_cast<double>(i) / segments, {}, 0u});
+        }
+      }
+      if (signChange) ++signChanges;
+      if (wasSampled) ++sampled;
+      if (found.empty()) continue;
+
+      // One point per distinct parameter, positioned once in the edge's first face.
+      std::sort(found.begin(), found.end(),
+                [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
+      std::vector<EdgePoint>& points = out.edgePoints[e];
+      int owner = -1;
+      for (int k = 0; k < faces.size() && owner < 0; ++k) {
+        if (allSides >> k & 1u) owner = faces[k];
+      }
+      for (const EdgePoint& p : found) {
+        if (!points.empty() && p.t - points.back().t < 1e-9) {
+          points.back().sides |= p.sides;
+          continue;
+        }
+        EdgePoint q = p;
+        Vec2 uv = edgeUV(surface, owner, static_cast<int>(e), q.t);
+        q.position = surface.position(owner, uv.x, uv.y);
+        points.push_back(q);
+      }
+    }
+  });
+  cancel.check();
+
+  out.stats.edgesTested = tested;
+  out.stats.edgesWithSignChange = signChanges;
+  out.stats.edgesSampled = sampled;
+  out.stats.doubleCrossings = doubles;
+  out.stats.outlineEdges = outlines;
+  for (const auto& points : out.edgePoints) out.stats.contourPoints += points.size();
+  return out;
+}
+
+}  // namespace limn::render::silhouette

@@ -1,0 +1,106 @@
+#include "render/silhouette/face_triangulation.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace limn::render::silhouette {
+
+namespace {
+
+double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+// True when p lies inside or on triangle abc (counter-clockwise), with tolerance `eps`.
+bool inTriangle(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c, double eps) {
+  return cross2(a, b, p) >= -eps && cross2(b, c, p) >= -eps && cross2(c, a, p) >= -eps;
+}
+
+bool samePoint(const Vec2& a, const Vec2& b) { return a.x == b.x && a.y == b.y; }
+
+}  // namespace
+
+void earClip(const std::vector<Vec2>& uv, std::vector<int> polygon,
+             std::vector<std::array<int, 3>>& triangles) {
+  double scale = 0;
+  for (int i : polygon) scale = std::max({scale, std::fabs(uv[i].x), std::fabs(uv[i].y)});
+  const double areaEps = 1e-14 * std::max(scale * scale, 1e-30);
+
+  size_t cursor = 0;
+  while (polygon.size() > 3) {
+    const size_t n = polygon.size();
+    bool clipped = false;
+    for (size_t step = 0; step < n && !clipped; ++step) {
+      size_t i = (cursor + step) % n;
+      int a = polygon[(i + n - 1) % n], b = polygon[i], c = polygon[(i + 1) % n];
+      if (cross2(uv[a], uv[b], uv[c]) <= areaEps) continue;  // reflex or straight
+      bool empty = true;
+      for (size_t j = 0; j < n && empty; ++j) {
+        int q = polygon[j];
+        if (q == a || q == b || q == c) continue;
+        if (samePoint(uv[q], uv[a]) || samePoint(uv[q], uv[b]) || samePoint(uv[q], uv[c])) continue;
+        if (inTriangle(uv[q], uv[a], uv[b], uv[c], areaEps)) empty = false;
+      }
+      if (!empty) continue;
+      triangles.push_back({a, b, c});
+      polygon.erase(polygon.begin() + static_cast<long>(i));
+      cursor = i == 0 ? 0 : i - 1;
+      clipped = true;
+    }
+    if (!clipped) {
+      // No clean ear (a numerically degenerate polygon): cut the convex corner with the
+      // largest area regardless, so the face is still covered.
+      size_t best = 0;
+      double bestArea = -1e300;
+      for (size_t i = 0; i < n; ++i) {
+        double area = cross2(uv[polygon[(i + n - 1) % n]], uv[polygon[i]], uv[polygon[(i + 1) % n]]);
+        if (area > bestArea) {
+          bestArea = area;
+          best = i;
+        }
+      }
+      if (bestArea > areaEps) {
+        triangles.push_back({polygon[(best + n - 1) % n], polygon[best], polygon[(best + 1) % n]});
+      }
+      polygon.erase(polygon.begin() + static_cast<long>(best));
+      cursor = 0;
+    }
+  }
+  if (polygon.size() == 3 && cross2(uv[polygon[0]], uv[polygon[1]], uv[polygon[2]]) > areaEps) {
+    triangles.push_back({polygon[0], polygon[1], polygon[2]});
+  }
+}
+
+std::vector<std::array<int, 3>> triangulateFace(const std::vector<Vec2>& uv, int boundaryCount,
+                                                const std::vector<CurvePath>& curves) {
+  std::vector<std::vector<int>> regions(1);
+  for (int i = 0; i < boundaryCount; ++i) regions[0].push_back(i);
+
+  for (const CurvePath& curve : curves) {
+    for (size_t r = 0; r < regions.size(); ++r) {
+      std::vector<int>& region = regions[r];
+      auto ia = std::find(region.begin(), region.end(), curve.from);
+      auto ib = std::find(region.begin(), region.end(), curve.to);
+      if (ia == region.end() || ib == region.end()) continue;
+      // Rotate so the region starts at `from`: [from, ..., to, ...].
+      std::rotate(region.begin(), ia, region.end());
+      size_t toAt = static_cast<size_t>(std::find(region.begin(), region.end(), curve.to) -
+                                        region.begin());
+      // First part: from -> (boundary) -> to -> (curve backwards) -> from.
+      std::vector<int> first(region.begin(), region.begin() + static_cast<long>(toAt) + 1);
+      first.insert(first.end(), curve.interior.rbegin(), curve.interior.rend());
+      // Second part: to -> (boundary) -> from -> (curve forwards) -> to.
+      std::vector<int> second(region.begin() + static_cast<long>(toAt), region.end());
+      second.push_back(curve.from);
+      second.insert(second.end(), curve.interior.begin(), curve.interior.end());
+      region = std::move(first);
+      regions.push_back(std::move(second));
+      break;
+    }
+  }
+  std::vector<std::array<int, 3>> triangles;
+  for (const std::vector<int>& region : regions) earClip(uv, region, triangles);
+  return triangles;
+}
+
+}  // namespace limn::render::silhouette

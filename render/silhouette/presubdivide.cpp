@@ -1,0 +1,96 @@
+#include "render/silhouette/presubdivide.h"
+
+#include <memory>
+
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyRefiner.h>
+
+#include "render/subdiv/limit_surface.h"
+
+namespace limn::render::silhouette {
+
+namespace Far = OpenSubdiv::Far;
+
+namespace {
+
+// The primvar type Far's PrimvarRefiner interpolates.
+struct Point {
+  Vec3 p;
+  void Clear(void* = nullptr) { p = {0, 0, 0}; }
+  void AddWithWeight(const Point& o, float w) { p += o.p * static_cast<double>(w); }
+};
+
+}  // namespace
+
+bool hasSimpleFaces(const mesh::ControlMesh& mesh) {
+  int want = mesh.scheme == mesh::Scheme::Loop ? 3 : 4;
+  for (int n : mesh.faceVertexCounts) {
+    if (n != want) return false;
+  }
+  return true;
+}
+
+std::string presubdivisionReason(const mesh::ControlMesh& mesh) {
+  if (mesh.faceCount() < kAutoFaceLimit) return "it has fewer than 500 faces";
+  if (!hasSimpleFaces(mesh)) {
+    return mesh.scheme == mesh::Scheme::Loop ? "it has non-triangle faces"
+                                             : "it has non-quad faces";
+  }
+  // Regular valence is 4 for Catmull-Clark and 6 for Loop.
+  const int regular = mesh.scheme == mesh::Scheme::Loop ? 6 : 4;
+  subdiv::LimitSurface probe(mesh);
+  const Far::TopologyLevel& level = probe.baseLevel();
+  auto extraordinary = [&](int v) {
+    return !level.IsVertexBoundary(v) && level.GetVertexEdges(v).size() != regular;
+  };
+  for (int e = 0; e < level.GetNumEdges(); ++e) {
+    Far::ConstIndexArray ends = level.GetEdgeVertices(e);
+    if (extraordinary(ends[0]) && extraordinary(ends[1])) {
+      return "edge " + std::to_string(e) + " joins two extraordinary vertices";
+    }
+  }
+  return {};
+}
+
+mesh::ControlMesh refineOnce(const mesh::ControlMesh& mesh) {
+  subdiv::LimitSurface probe(mesh);
+  std::unique_ptr<Far::TopologyRefiner> refiner = probe.createRefiner();
+  Far::TopologyRefiner::UniformOptions options(1);
+  options.fullTopologyInLastLevel = true;
+  refiner->RefineUniform(options);
+  const Far::TopologyLevel& fine = refiner->GetLevel(1);
+
+  std::vector<Point> coarsePoints(mesh.points.size());
+  for (size_t i = 0; i < mesh.points.size(); ++i) coarsePoints[i].p = mesh.points[i];
+  std::vector<Point> finePoints(fine.GetNumVertices());
+  Point* src = coarsePoints.data();
+  Point* dst = finePoints.data();
+  Far::PrimvarRefiner(*refiner).Interpolate(1, src, dst);
+
+  mesh::ControlMesh out;
+  out.scheme = mesh.scheme;
+  out.boundary = mesh.boundary;
+  out.creaseMethod = mesh.creaseMethod;
+  out.triangleSubdivision = mesh.triangleSubdivision;
+  out.points.reserve(finePoints.size());
+  for (const Point& p : finePoints) out.points.push_back(p.p);
+  for (int f = 0; f < fine.GetNumFaces(); ++f) {
+    Far::ConstIndexArray verts = fine.GetFaceVertices(f);
+    out.faceVertexCounts.push_back(verts.size());
+    for (int v : verts) out.faceVertexIndices.push_back(v);
+    if (fine.IsFaceHole(f)) out.holes.push_back(f);
+  }
+  for (int e = 0; e < fine.GetNumEdges(); ++e) {
+    float sharpness = fine.GetEdgeSharpness(e);
+    if (sharpness <= 0) continue;
+    Far::ConstIndexArray ends = fine.GetEdgeVertices(e);
+    out.creases.push_back({ends[0], ends[1], sharpness});
+  }
+  for (int v = 0; v < fine.GetNumVertices(); ++v) {
+    float sharpness = fine.GetVertexSharpness(v);
+    if (sharpness > 0) out.corners.push_back({v, sharpness});
+  }
+  return out;
+}
+
+}  // namespace limn::render::silhouette

@@ -1,0 +1,59 @@
+// The silhouette method: a coarse (pre-subdivided) control mesh drawn with its vertices on the
+// limit surface, where only the faces the contour passes through are re-triangulated through
+// contour curves found on the limit surface itself. The outline then follows the exact limit
+// contour while the triangle count stays near the coarse mesh's.
+//
+//   searchContour   edges -> edge points where g = dot(n, p - eye) changes sign
+//   faceCurves      per face: crossings paired, curves sampled ("pn" or "exact")
+//   triangulateFace per face with edge points: regions cut by the curves, ear-clipped in (u, v)
+// Faces with no edge point keep their corners: quads as two triangles, triangles as one.
+#pragma once
+
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/silhouette/contour_search.h"
+#include "render/silhouette/face_contour.h"
+#include "render/subdiv/limit_surface.h"
+#include "render/tessellate/triangle_mesh.h"
+
+namespace limn::render::silhouette {
+
+struct SilhouetteOptions {
+  SearchOptions search;
+  CurveOptions curves;
+  size_t maxTriangles = 8'000'000;
+};
+
+// One contour curve inside one face, endpoints included (both are edge points).
+struct ContourCurve {
+  int face = -1;
+  int fromEdge = -1, fromPoint = -1;  // ContourSearch::edgePoints[fromEdge][fromPoint]
+  int toEdge = -1, toPoint = -1;
+  std::vector<FacePoint> points;
+};
+
+struct SilhouetteStats {
+  SearchStats search;
+  size_t contourFaces = 0;    // faces holding at least one contour curve
+  size_t correctedFaces = 0;  // faces re-triangulated (contour faces and their edge neighbours)
+  size_t trianglesAdded = 0;  // triangles drawn beyond the coarse mesh's
+  size_t trianglesDrawn = 0;
+  size_t curveSamples = 0;
+  size_t unresolvedSamples = 0;  // exact samples that found no root (left on the straight line)
+  size_t oddFaces = 0;           // faces with an odd crossing count (drawn without a curve)
+};
+
+struct SilhouetteMesh {
+  tessellate::TriangleMesh mesh;
+  ContourSearch search;
+  std::vector<ContourCurve> curves;
+  std::vector<bool> corrected;  // per face
+  SilhouetteStats stats;
+};
+
+SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Camera& camera,
+                                   const SilhouetteOptions& options, const CancelToken& cancel);
+
+}  // namespace limn::render::silhouette

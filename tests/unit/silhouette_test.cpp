@@ -1,0 +1,175 @@
+// The silhouette method's pieces: contour search (including double crossings), curves on the
+// limit surface, local re-triangulation, pre-subdivision.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include "render/silhouette/contour_search.h"
+#include "render/silhouette/face_triangulation.h"
+#include "render/silhouette/presubdivide.h"
+#include "render/silhouette/silhouette_mesh.h"
+#include "render/subdiv/limit_surface.h"
+#include "tests/unit/test_meshes.h"
+
+namespace limn::render::silhouette {
+namespace {
+
+using limn::testing::addFace;
+using mesh::ControlMesh;
+
+// A strip of quads across a straight ridge along y: heights 0 except the column x = 0 at
+// `height`. On the edge from x = -1 to x = 0 the limit slope goes 1/2 -> 2/3 -> 0 (times the
+// height), so a view whose ray rises at slope 0.58 sees both ends of that edge in front and its
+// middle from behind: two crossings on one edge whose ends agree.
+ControlMesh ridge(double height = 1.0) {
+  ControlMesh m;
+  const int nx = 6, ny = 4;
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) {
+      double x = i - nx / 2;
+      m.points.push_back({x, j - ny / 2.0, x == 0 ? height : 0.0});
+    }
+  }
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      int a = j * (nx + 1) + i;
+      addFace(m, {a, a + 1, a + nx + 2, a + nx + 1});
+    }
+  }
+  return m;
+}
+
+// Orthographic view along -x, tilted down so its ray has slope `slope`.
+Camera sideView(double slope, int size = 512) {
+  Vec3 target{0, 0, 0.3};
+  Vec3 dir = normalize(Vec3{-1, 0, -slope});
+  return Camera(target - dir * 20.0, target, {0, 0, 1}, 35, Projection::Orthographic, 5.0, size,
+                size, 1, 40);
+}
+
+CameraSpec obliqueView() {
+  CameraSpec spec;
+  spec.eye = Vec3{1.2, 2.0, 2.5};
+  return spec;
+}
+
+TEST(ContourSearch, FindsBothCrossingsOfAnEdgeWhoseEndsAgree) {
+  subdiv::LimitSurface surface(ridge());
+  Camera camera = sideView(0.58);
+  const auto& base = surface.baseLevel();
+  for (int samples : {1, 4}) {
+    SearchOptions options;
+    options.edgeSamples = samples;  // 1: only the slope test can see the pair
+    ContourSearch search = searchContour(surface, camera, options, CancelToken());
+    int doubled = 0;
+    for (int e = 0; e < base.GetNumEdges(); ++e) {
+      auto ends = base.GetEdgeVertices(e);
+      Vec3 a = surface.mesh().points[ends[0]], b = surface.mesh().points[ends[1]];
+      bool leftFlank = std::fabs(a.y - b.y) < 1e-9 && std::min(a.x, b.x) == -1 &&
+                       std::max(a.x, b.x) == 0;
+      if (!leftFlank) continue;
+      int crossings = 0;
+      for (const EdgePoint& p : search.edgePoints[e]) {
+        if (p.sides == 0) continue;  // a point shaping a boundary edge, not a crossing
+        ++crossings;
+        // On the contour: the limit normal there is perpendicular to the view.
+        Vec2 uv = edgeUV(surface, base.GetEdgeFaces(e)[0], e, p.t);
+        subdiv::LimitSample s = surface.evaluate(base.GetEdgeFaces(e)[0], uv.x, uv.y);
+        EXPECT_LT(std::fabs(dot(s.normal, camera.forward())), 0.02);
+      }
+      EXPECT_EQ(crossings, 2) << "edge " << e << " with " << samples << " samples";
+      ++doubled;
+    }
+    EXPECT_EQ(doubled, 5);
+    EXPECT_GE(search.stats.doubleCrossings, 5u);
+  }
+}
+
+TEST(ContourSearch, ExactCurvesLieOnTheContour) {
+  for (auto [name, cage] : {std::pair{"cube", limn::testing::cube()},
+                            std::pair{"icosahedron", limn::testing::icosahedron()},
+                            std::pair{"torus", limn::testing::torus(12, 8, false)}}) {
+    subdiv::LimitSurface surface(refineOnce(cage));
+    Camera camera = resolveCamera(obliqueView(), surface.bounds());
+    SilhouetteMesh result = buildSilhouetteMesh(surface, camera, {}, CancelToken());
+    EXPECT_GT(result.curves.size(), 8u) << name;
+    EXPECT_EQ(result.stats.oddFaces, 0u) << name;
+    EXPECT_EQ(result.stats.unresolvedSamples, 0u) << name;
+    for (const ContourCurve& curve : result.curves) {
+      for (const FacePoint& p : curve.points) {
+        double cosine = dot(p.normal, normalize(camera.viewVector(p.position)));
+        EXPECT_LT(std::fabs(cosine), 1e-3) << name << " face " << curve.face;
+      }
+    }
+  }
+}
+
+// Every edge of the drawn mesh, keyed by its end positions, is used by exactly two triangles:
+// no crack and no T-junction on a closed surface.
+TEST(SilhouetteMesh, IsWatertightOnClosedMeshes) {
+  for (auto [name, cage] : {std::pair{"cube", limn::testing::cube()},
+                            std::pair{"icosahedron", limn::testing::icosahedron()},
+                            std::pair{"torus", limn::testing::torus(12, 8, true)}}) {
+    subdiv::LimitSurface surface(refineOnce(cage));
+    Camera camera = resolveCamera(obliqueView(), surface.bounds());
+    for (CurveMode mode : {CurveMode::Exact, CurveMode::PN}) {
+      SilhouetteOptions options;
+      options.curves.mode = mode;
+      SilhouetteMesh result = buildSilhouetteMesh(surface, camera, options, CancelToken());
+      const auto& m = result.mesh;
+      using Key = std::tuple<float, float, float>;
+      auto key = [&](uint32_t i) { return Key{m.positions[i].x, m.positions[i].y, m.positions[i].z}; };
+      std::map<std::pair<Key, Key>, int> uses;
+      for (size_t t = 0; t < m.triangleCount(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+          Key a = key(m.indices[3 * t + k]), b = key(m.indices[3 * t + (k + 1) % 3]);
+          ++uses[std::minmax(a, b)];
+        }
+      }
+      int bad = 0;
+      for (const auto& [edge, count] : uses) bad += count != 2;
+      EXPECT_EQ(bad, 0) << name;
+      EXPECT_GT(result.stats.trianglesAdded, 0u);
+      EXPECT_GT(result.stats.contourFaces, 0u);
+    }
+  }
+}
+
+TEST(FaceTriangulation, CoversTheFaceWithStraightRunsKept) {
+  // Unit square with two extra points on its bottom edge and a curve from the bottom to the top.
+  std::vector<Vec2> uv = {{0, 0}, {0.3, 0}, {0.6, 0}, {1, 0}, {1, 1}, {0.5, 1}, {0, 1},
+                          {0.45, 0.3}, {0.55, 0.7}};
+  std::vector<std::array<int, 3>> triangles = triangulateFace(uv, 7, {{1, 5, {7, 8}}});
+  double area = 0;
+  std::vector<int> used(uv.size(), 0);
+  for (const auto& t : triangles) {
+    double a = 0.5 * ((uv[t[1]].x - uv[t[0]].x) * (uv[t[2]].y - uv[t[0]].y) -
+                      (uv[t[1]].y - uv[t[0]].y) * (uv[t[2]].x - uv[t[0]].x));
+    EXPECT_GT(a, 0);
+    area += a;
+    for (int k : t) ++used[k];
+  }
+  EXPECT_NEAR(area, 1.0, 1e-12);
+  for (size_t i = 0; i < uv.size(); ++i) EXPECT_GT(used[i], 0) << "point " << i << " unused";
+  // No triangle crosses the curve 1 -> 7 -> 8 -> 5: each lies on one side of it.
+}
+
+TEST(Presubdivide, KeepsTheLimitSurface) {
+  ControlMesh cage = limn::testing::torus(12, 8, true);
+  subdiv::LimitSurface coarse(cage);
+  subdiv::LimitSurface fine(refineOnce(cage));
+  EXPECT_EQ(fine.faceCount(), 4 * coarse.faceCount());
+  // Fine vertex v that is a child of coarse vertex v has the same limit position.
+  for (int v = 0; v < cage.vertexCount(); ++v) {
+    Vec3 a = coarse.controlLimitPositions()[v];
+    double best = 1e300;
+    for (const Vec3& b : fine.controlLimitPositions()) best = std::min(best, length(a - b));
+    EXPECT_LT(best, 1e-6) << "vertex " << v;
+  }
+  EXPECT_FALSE(presubdivisionReason(cage).empty());
+}
+
+}  // namespace
+}  // namespace limn::render::silhouette
