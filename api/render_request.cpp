@@ -88,22 +88,59 @@ render::CameraSpec parseCamera(const Value& camera, const JobLimits& limits,
 
 Method parseMethod(const Value& value) {
   std::string_view name = json::string(value, "method");
-  if (name == "silhouette" || name == "patches") {
+  if (name == "patches") {
     json::fail("method", "method " + json::quote(name) +
                              " is not implemented yet; available: \"coarse\", \"uniform\", "
-                             "\"adaptive\", \"limit\"");
+                             "\"adaptive\", \"limit\", \"silhouette\"");
   }
   return json::choice<Method>(value, "method",
                               {{"coarse", Method::Coarse},
                                {"uniform", Method::Uniform},
                                {"adaptive", Method::Adaptive},
-                               {"limit", Method::Limit}});
+                               {"limit", Method::Limit},
+                               {"silhouette", Method::Silhouette}});
+}
+
+// params of the silhouette method (read whatever the method; they only matter to it).
+void parseSilhouetteParams(const Value& params, const JobLimits& limits,
+                           render::pipeline::MethodParams& out) {
+  using render::silhouette::Presubdivide;
+  if (const Value* v = json::find(params, "presubdivide")) {
+    if (v->IsString() && std::string_view(v->GetString()) == "auto") {
+      out.presubdivide = Presubdivide::Auto;
+    } else if (v->IsInt() && (v->GetInt() == 0 || v->GetInt() == 1)) {
+      out.presubdivide = v->GetInt() == 0 ? Presubdivide::Never : Presubdivide::Once;
+    } else {
+      json::fail("params.presubdivide",
+                 "params.presubdivide must be \"auto\", 0 or 1; got " + json::describe(*v));
+    }
+  }
+  auto boundedInt = [&](const char* name, int& field, int lo, int hi, const char* limitName) {
+    const Value* v = json::find(params, name);
+    if (!v) return;
+    std::string path = std::string("params.") + name;
+    field = json::integer(*v, path);
+    if (field < lo) json::fail(path, path + " must be >= " + std::to_string(lo));
+    if (field > hi) {
+      throw tooLarge(limitName, path,
+                     path + " " + std::to_string(field) + " exceeds limit " + limitName + " (" +
+                         std::to_string(hi) + ")");
+    }
+  };
+  boundedInt("searchSteps", out.searchSteps, 0, limits.maxSearchSteps, "maxSearchSteps");
+  boundedInt("curveSamples", out.curveSamples, 0, limits.maxCurveSamples, "maxCurveSamples");
+  if (const Value* v = json::find(params, "contour")) {
+    out.contour = json::choice<render::silhouette::CurveMode>(
+        *v, "params.contour",
+        {{"exact", render::silhouette::CurveMode::Exact}, {"pn", render::silhouette::CurveMode::PN}});
+  }
 }
 
 render::pipeline::MethodParams parseParams(const Value& params, const JobLimits& limits,
                                            std::vector<std::string>& warnings) {
   json::requireObject(params, "params");
-  warnUnknownFields(params, "params", {"level", "dicingRate", "metricSupersample"}, warnings);
+  warnUnknownFields(params, "params", {"level", "dicingRate", "metricSupersample", "presubdivide",
+                                       "searchSteps", "curveSamples", "contour"}, warnings);
   render::pipeline::MethodParams out;
   if (const Value* v = json::find(params, "level")) {
     out.level = json::integer(*v, "params.level");
@@ -136,6 +173,7 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
                          ")");
     }
   }
+  parseSilhouetteParams(params, limits, out);
   return out;
 }
 
@@ -143,15 +181,17 @@ render::pipeline::Outputs parseOutputs(const Value& value) {
   json::requireArray(value, "outputs");
   render::pipeline::Outputs out;
   out.color = false;
-  enum Pass { Color, Mask, Depth, Normal, Wireframe };
+  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours };
   for (rapidjson::SizeType i = 0; i < value.Size(); ++i) {
     Pass pass = json::choice<Pass>(value[i], "outputs[" + std::to_string(i) + "]",
                                    {{"color", Color},
                                     {"mask", Mask},
                                     {"depth", Depth},
                                     {"normal", Normal},
-                                    {"wireframe", Wireframe}});
-    bool* flags[] = {&out.color, &out.mask, &out.depth, &out.normal, &out.wireframe};
+                                    {"wireframe", Wireframe},
+                                    {"contours", Contours}});
+    bool* flags[] = {&out.color, &out.mask, &out.depth, &out.normal, &out.wireframe,
+                     &out.contours};
     *flags[pass] = true;
   }
   return out;
@@ -210,6 +250,9 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
         *v, "shading", {{"flat", render::Shading::Flat}, {"smooth", render::Shading::Smooth}});
   }
   if (const Value* v = json::find(root, "outputs")) job.outputs = parseOutputs(*v);
+  if (job.outputs.contours && job.method != Method::Silhouette) {
+    json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
+  }
   if (const Value* v = json::find(root, "reference"))
     job.reference = json::boolean(*v, "reference");
   if (const Value* v = json::find(root, "imageFormat")) {

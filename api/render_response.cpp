@@ -27,6 +27,7 @@ std::vector<const char*> requestedPasses(const Outputs& outputs) {
   if (outputs.depth) names.push_back(render::pass::kDepth);
   if (outputs.normal) names.push_back(render::pass::kNormal);
   if (outputs.wireframe) names.push_back(render::pass::kWireframe);
+  if (outputs.contours) names.push_back(render::pass::kContours);
   return names;
 }
 
@@ -34,6 +35,10 @@ void writeImages(Writer& w, const render::ImageSet& images, const RenderRequest&
                  const char* owner, std::vector<std::string>& warnings) {
   w.StartObject();
   for (const char* name : requestedPasses(request.job.outputs)) {
+    // The contour overlay belongs to the silhouette method; the reference has none.
+    if (std::string_view(owner) == "reference" && std::string_view(name) == render::pass::kContours) {
+      continue;
+    }
     const render::Image* image = images.find(name);
     if (!image || image->empty()) {
       warnings.push_back(std::string("output \"") + name + "\" was requested but the " + owner +
@@ -102,6 +107,31 @@ void writeMetrics(Writer& w, const render::metrics::Metrics& m) {
   w.EndObject();
 }
 
+void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& s,
+                          bool presubdivided) {
+  w.Key("silhouette");
+  w.StartObject();
+  w.Key("presubdivided");
+  w.Bool(presubdivided);
+  auto count = [&](const char* key, size_t value) {
+    w.Key(key);
+    w.Uint64(value);
+  };
+  count("edgesTested", s.search.edgesTested);
+  count("edgesWithSignChange", s.search.edgesWithSignChange);
+  count("edgesSampled", s.search.edgesSampled);
+  count("doubleCrossingEdges", s.search.doubleCrossings);
+  count("outlineEdges", s.search.outlineEdges);
+  count("contourPoints", s.search.contourPoints);
+  count("contourFaces", s.contourFaces);
+  count("correctedFaces", s.correctedFaces);
+  count("curveSamples", s.curveSamples);
+  count("unresolvedSamples", s.unresolvedSamples);
+  count("trianglesAdded", s.trianglesAdded);
+  count("trianglesDrawn", s.trianglesDrawn);
+  w.EndObject();
+}
+
 void writeStats(Writer& w, const render::pipeline::Stats& s) {
   w.StartObject();
   w.Key("controlVertices");
@@ -120,6 +150,7 @@ void writeStats(Writer& w, const render::pipeline::Stats& s) {
     numberField(w, "referenceCrossCheckPx", *s.referenceCrossCheckPx);
     numberField(w, "referenceCrossCheckMeanPx", s.referenceCrossCheckMeanPx.value_or(0.0));
   }
+  if (s.silhouette) writeSilhouetteStats(w, *s.silhouette, s.presubdivided);
   w.EndObject();
 }
 

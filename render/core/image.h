@@ -33,6 +33,7 @@ inline constexpr const char* kMask = "mask";            // 1 channel, 1 covered 
 inline constexpr const char* kDepth = "depth";          // 1 channel, linear depth, 0 = empty
 inline constexpr const char* kNormal = "normal";        // 3 channels, unit world normal
 inline constexpr const char* kWireframe = "wireframe";  // RGBA, colour with edges drawn over
+inline constexpr const char* kContours = "contours";    // RGBA, colour with the contour drawn over
 }  // namespace pass
 
 // The passes of one rendering (approximation or reference) of one camera.

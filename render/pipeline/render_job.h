@@ -15,6 +15,8 @@
 #include "render/core/passes.h"
 #include "render/mesh/control_mesh.h"
 #include "render/metrics/metrics.h"
+#include "render/silhouette/presubdivide.h"
+#include "render/silhouette/silhouette_mesh.h"
 
 namespace limn::render::raster {
 class Rasterizer;
@@ -22,16 +24,22 @@ class Rasterizer;
 
 namespace limn::render::pipeline {
 
-enum class Method { Coarse, Uniform, Adaptive, Limit };
+enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette };
 
 struct MethodParams {
   int level = 3;                // uniform
   double dicingRate = 1.0;      // adaptive: target edge length in pixels
   int metricSupersample = 4;    // S for the silhouette metrics
+  // silhouette
+  silhouette::Presubdivide presubdivide = silhouette::Presubdivide::Auto;
+  int searchSteps = 5;          // bisection steps of the edge search
+  int curveSamples = 32;        // samples per contour curve at most
+  silhouette::CurveMode contour = silhouette::CurveMode::Exact;
 };
 
 struct Outputs {
   bool color = true, mask = false, depth = false, normal = false, wireframe = false;
+  bool contours = false;  // silhouette: contour curves, corrected faces, searched edges
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.
@@ -41,6 +49,8 @@ struct JobLimits {
   int maxSupersample = 8;
   int maxLevel = 6;
   double minDicingRate = 0.25;
+  int maxSearchSteps = 30;
+  int maxCurveSamples = 256;
   size_t maxTriangles = 8'000'000;
 };
 
@@ -64,6 +74,9 @@ struct Stats {
   // Quantised to 1/metricSupersample: a single differing supersampled pixel reads 1/S.
   std::optional<double> referenceCrossCheckPx;
   std::optional<double> referenceCrossCheckMeanPx;  // mean outline distance of the same pair
+  // The silhouette method's own counts (absent for other methods).
+  std::optional<silhouette::SilhouetteStats> silhouette;
+  bool presubdivided = false;
 };
 
 struct Timings {

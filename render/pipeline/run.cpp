@@ -5,6 +5,7 @@
 #include "render/oracle/reference.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
+#include "render/silhouette/contour_overlay.h"
 #include "render/subdiv/limit_surface.h"
 #include "render/tessellate/tessellate.h"
 
@@ -37,6 +38,13 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
   if (!(p.dicingRate >= limits.minDicingRate)) {
     badParameter("params.dicingRate", "must be >= " + std::to_string(limits.minDicingRate));
   }
+  if (p.searchSteps < 0 || p.searchSteps > limits.maxSearchSteps) {
+    badParameter("params.searchSteps", "must be in 0.." + std::to_string(limits.maxSearchSteps));
+  }
+  if (p.curveSamples < 0 || p.curveSamples > limits.maxCurveSamples) {
+    badParameter("params.curveSamples",
+                 "must be in 0.." + std::to_string(limits.maxCurveSamples));
+  }
   if (p.metricSupersample < 1 || p.metricSupersample > limits.maxSupersample) {
     badParameter("params.metricSupersample",
                  "must be in 1.." + std::to_string(limits.maxSupersample));
@@ -63,9 +71,54 @@ tessellate::TriangleMesh approximate(const RenderJob& job, const JobLimits& limi
       options.maxTriangles = limits.maxTriangles;
       return tessellate::tessellateAdaptive(surface, camera, options, cancel);
     }
-    case Method::Limit: break;
+    case Method::Limit:
+    case Method::Silhouette: break;  // see runSilhouette
   }
   return {};
+}
+
+// The silhouette method draws a (possibly pre-subdivided) copy of the mesh: same limit
+// surface, finer cage. `drawn` keeps that surface alive for the caller.
+silhouette::SilhouetteMesh runSilhouette(const RenderJob& job, const JobLimits& limits,
+                                         const subdiv::LimitSurface& surface,
+                                         const Camera& camera, const CancelToken& cancel,
+                                         std::unique_ptr<subdiv::LimitSurface>& drawn,
+                                         RenderResult& result) {
+  using silhouette::Presubdivide;
+  bool refine = job.params.presubdivide == Presubdivide::Once;
+  if (job.params.presubdivide == Presubdivide::Auto) {
+    refine = !silhouette::presubdivisionReason(job.mesh).empty();
+  }
+  if (!refine && !silhouette::hasSimpleFaces(job.mesh)) {
+    refine = true;
+    result.warnings.push_back(
+        "params.presubdivide 0 overridden: the silhouette method triangulates quads "
+        "(Catmull-Clark) or triangles (Loop) only, so the mesh was refined once");
+  }
+  const subdiv::LimitSurface* base = &surface;
+  if (refine) {
+    drawn = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(job.mesh));
+    base = drawn.get();
+  }
+  result.stats.presubdivided = refine;
+  silhouette::SilhouetteOptions options;
+  options.search.searchSteps = job.params.searchSteps;
+  options.search.outlineSamples = job.params.curveSamples;
+  options.curves.curveSamples = job.params.curveSamples;
+  options.curves.mode = job.params.contour;
+  options.maxTriangles = limits.maxTriangles;
+  silhouette::SilhouetteMesh out = silhouette::buildSilhouetteMesh(*base, camera, options, cancel);
+  if (out.stats.oddFaces > 0) {
+    result.warnings.push_back(std::to_string(out.stats.oddFaces) +
+                              " faces had an odd number of contour crossings and were drawn "
+                              "without a contour curve");
+  }
+  if (out.stats.unresolvedSamples > 0) {
+    result.warnings.push_back(std::to_string(out.stats.unresolvedSamples) +
+                              " exact contour samples found no root and stayed on the chord");
+  }
+  result.stats.silhouette = out.stats;
+  return out;
 }
 
 // Keeps only the passes the client asked for; the wireframe of the reference is its colour
@@ -85,6 +138,7 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   keep(outputs.depth, pass::kDepth);
   keep(outputs.normal, pass::kNormal);
   if (!isReference) keep(outputs.wireframe, pass::kWireframe);
+  if (!isReference) keep(outputs.contours, pass::kContours);
   return selected;
 }
 
@@ -96,6 +150,7 @@ const char* methodName(Method method) {
     case Method::Uniform: return "uniform";
     case Method::Adaptive: return "adaptive";
     case Method::Limit: return "limit";
+    case Method::Silhouette: return "silhouette";
   }
   return "?";
 }
@@ -122,8 +177,20 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
 
   // The approximation and its raster passes (all of them when metrics need them).
   std::optional<tessellate::TriangleMesh> approx;
-  if (job.method != Method::Limit) {
+  std::vector<LineOverlay> overlays;
+  std::unique_ptr<subdiv::LimitSurface> presubdivided;
+  if (job.method == Method::Silhouette) {
+    silhouette::SilhouetteMesh built =
+        runSilhouette(job, limits, surface, camera, cancel, presubdivided, result);
+    if (job.outputs.contours) {
+      overlays.push_back(silhouette::contourOverlay(
+          presubdivided ? *presubdivided : surface, built, pass::kContours));
+    }
+    approx = std::move(built.mesh);
+  } else if (job.method != Method::Limit) {
     approx = approximate(job, limits, surface, camera, cancel);
+  }
+  if (approx) {
     result.stats.triangles = approx->triangleCount();
     result.stats.vertices = approx->vertexCount();
     result.timings.approxMs = clock.lapMs();
@@ -136,7 +203,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
                          .wireframe = job.outputs.wireframe,
                          .supersample = measure ? S : 0};
     if (context.rasterizer == nullptr) throw std::runtime_error("no rasterizer in this context");
-    result.images = context.rasterizer->render(*approx, camera, passes, job.shading);
+    result.images = context.rasterizer->render(*approx, camera, passes, job.shading, overlays);
     result.timings.rasterMs = clock.lapMs();
     cancel.check();
   }
@@ -186,7 +253,11 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     }
     if (job.reference) result.referenceImages = selectOutputs(std::move(reference.images), job.outputs, true);
   }
-  if (approx && job.reference) result.metrics.geometry = metrics::measureGeometry(*approx, surface);
+  if (approx && job.reference) {
+    // Silhouette meshes live on the pre-subdivided copy: the same limit surface, finer faces.
+    result.metrics.geometry =
+        metrics::measureGeometry(*approx, presubdivided ? *presubdivided : surface);
+  }
   result.timings.metricsMs = clock.lapMs();
 
   if (job.method != Method::Limit) result.images = selectOutputs(std::move(result.images), job.outputs, false);
