@@ -13,8 +13,9 @@ struct PassSelection {
 };
 
 enum class Shading {
-  Flat,   // one normal per triangle (the geometric one)
-  Smooth  // interpolated per-vertex normals (limit normals where the method has them)
+  Flat,      // one normal per triangle (the geometric one)
+  Smooth,    // interpolated per-vertex normals (limit normals where the method has them)
+  NormalMap  // per-pixel normals read from TriangleMesh::normalMap at TriangleMesh::texcoords
 };
 
 }  // namespace limn::render

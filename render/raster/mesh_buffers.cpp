@@ -13,9 +13,11 @@ namespace limn::render::raster {
 namespace {
 
 static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
+static_assert(sizeof(Vec2f) == 2 * sizeof(float), "Vec2f must be two packed floats");
 
 constexpr GLuint kPositionAttribute = 0;
 constexpr GLuint kNormalAttribute = 1;
+constexpr GLuint kTexcoordAttribute = 2;
 
 void checkIndices(const std::vector<uint32_t>& indices, size_t groupSize, size_t vertexCount,
                   const char* what) {
@@ -52,12 +54,13 @@ void describePositions(GLuint array, GLuint positions) {
 }  // namespace
 
 MeshBuffers::MeshBuffers() {
-  GLuint buffers[4];
-  glCreateBuffers(4, buffers);
+  GLuint buffers[5];
+  glCreateBuffers(5, buffers);
   positions_ = buffers[0];
   normals_ = buffers[1];
   triangleIndices_ = buffers[2];
   lineIndices_ = buffers[3];
+  texcoords_ = buffers[4];
   glCreateVertexArrays(1, &triangleArray_);
   glCreateVertexArrays(1, &lineArray_);
 
@@ -65,6 +68,9 @@ MeshBuffers::MeshBuffers() {
   glVertexArrayVertexBuffer(triangleArray_, kNormalAttribute, normals_, 0, sizeof(Vec3f));
   glVertexArrayAttribFormat(triangleArray_, kNormalAttribute, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(triangleArray_, kNormalAttribute, kNormalAttribute);
+  glVertexArrayVertexBuffer(triangleArray_, kTexcoordAttribute, texcoords_, 0, sizeof(Vec2f));
+  glVertexArrayAttribFormat(triangleArray_, kTexcoordAttribute, 2, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(triangleArray_, kTexcoordAttribute, kTexcoordAttribute);
   glVertexArrayElementBuffer(triangleArray_, triangleIndices_);
 
   describePositions(lineArray_, positions_);
@@ -75,17 +81,22 @@ MeshBuffers::MeshBuffers() {
 MeshBuffers::~MeshBuffers() {
   GLuint arrays[2] = {triangleArray_, lineArray_};
   glDeleteVertexArrays(2, arrays);
-  GLuint buffers[4] = {positions_, normals_, triangleIndices_, lineIndices_};
-  glDeleteBuffers(4, buffers);
+  GLuint buffers[5] = {positions_, normals_, triangleIndices_, lineIndices_, texcoords_};
+  glDeleteBuffers(5, buffers);
 }
 
-void MeshBuffers::upload(const tessellate::TriangleMesh& mesh) {
+void MeshBuffers::upload(const tessellate::TriangleMesh& mesh, bool withTexcoords) {
   const size_t vertexCount = mesh.positions.size();
   checkIndices(mesh.indices, 3, vertexCount, "triangle");
   checkIndices(mesh.lines, 2, vertexCount, "line");
   if (!mesh.normals.empty() && mesh.normals.size() != vertexCount) {
     throw std::invalid_argument("raster: " + std::to_string(mesh.normals.size()) +
                                 " normals for " + std::to_string(vertexCount) + " vertices");
+  }
+  if (!mesh.texcoords.empty() && mesh.texcoords.size() != vertexCount) {
+    throw std::invalid_argument("raster: " + std::to_string(mesh.texcoords.size()) +
+                                " texture coordinates for " + std::to_string(vertexCount) +
+                                " vertices");
   }
 
   fill(positions_, mesh.positions);
@@ -99,6 +110,13 @@ void MeshBuffers::upload(const tessellate::TriangleMesh& mesh) {
     // A zero normal makes the fragment shader fall back to the face normal.
     glDisableVertexArrayAttrib(triangleArray_, kNormalAttribute);
     glVertexAttrib3f(kNormalAttribute, 0.0f, 0.0f, 0.0f);
+  }
+  if (withTexcoords && !mesh.texcoords.empty()) {
+    fill(texcoords_, mesh.texcoords);
+    glEnableVertexArrayAttrib(triangleArray_, kTexcoordAttribute);
+  } else {
+    glDisableVertexArrayAttrib(triangleArray_, kTexcoordAttribute);
+    glVertexAttrib2f(kTexcoordAttribute, 0.0f, 0.0f);
   }
   triangleIndexCount_ = static_cast<GLsizei>(mesh.indices.size());
   lineIndexCount_ = static_cast<GLsizei>(mesh.lines.size());

@@ -15,9 +15,10 @@ class MeshBuffers {
   MeshBuffers(const MeshBuffers&) = delete;
   MeshBuffers& operator=(const MeshBuffers&) = delete;
 
-  // Uploads positions, normals (when there is one per vertex), triangle indices and edges.
-  // Throws std::invalid_argument for indices out of range or mismatched array sizes.
-  void upload(const tessellate::TriangleMesh& mesh);
+  // Uploads positions, normals (when there is one per vertex), texture coordinates (when
+  // `withTexcoords` and there is one per vertex), triangle indices and edges. Throws
+  // std::invalid_argument for indices out of range or mismatched array sizes.
+  void upload(const tessellate::TriangleMesh& mesh, bool withTexcoords);
 
   bool hasNormals() const { return hasNormals_; }
   void drawTriangles() const;
@@ -26,7 +27,7 @@ class MeshBuffers {
 
  private:
   GLuint triangleArray_ = 0, lineArray_ = 0;
-  GLuint positions_ = 0, normals_ = 0, triangleIndices_ = 0, lineIndices_ = 0;
+  GLuint positions_ = 0, normals_ = 0, texcoords_ = 0, triangleIndices_ = 0, lineIndices_ = 0;
   GLsizei triangleIndexCount_ = 0, lineIndexCount_ = 0;
   bool hasNormals_ = false;
 };

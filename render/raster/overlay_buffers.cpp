@@ -25,8 +25,8 @@ struct LineVertex {
 static_assert(sizeof(LineVertex) == 16, "LineVertex must be tightly packed");
 
 bool isBuiltInPass(const std::string& name) {
-  for (const char* builtIn : {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal,
-                              pass::kWireframe}) {
+  for (const char* builtIn :
+       {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal, pass::kWireframe}) {
     if (name == builtIn) return true;
   }
   return false;

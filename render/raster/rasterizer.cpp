@@ -11,6 +11,7 @@
 #include "render/raster/gl_api.h"
 #include "render/raster/gl_error.h"
 #include "render/raster/mesh_buffers.h"
+#include "render/raster/normal_texture.h"
 #include "render/raster/overlay_buffers.h"
 #include "render/raster/shader_program.h"
 #include "render/raster/shaders.h"
@@ -105,6 +106,7 @@ struct Rasterizer::Impl {
   ShaderProgram lineProgram{"line", lineVertexShader(), lineFragmentShader(),
                             lineGeometryShader()};
   MeshBuffers mesh;
+  NormalTexture normalTexture;
   OverlayBuffers overlayLines;
   Framebuffer frame{{GL_RGBA32F, GL_R32F, GL_RGBA32F, GL_RGBA8}, /*withDepth=*/true};
   Framebuffer coverage{{GL_R8}, /*withDepth=*/false};
@@ -127,6 +129,7 @@ Rasterizer::Impl::Impl() {
   device.vendor = glString(GL_VENDOR);
   device.version = glString(GL_VERSION);
   device.eglPlatform = context.platform();
+  device.maxTextureSize = normalTexture.maxSide();
 
   const int largest = largestFramebufferSide();
   frameTileSize = std::min(largest, kFrameTileCap);
@@ -189,6 +192,10 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
   surfaceProgram.setVec3("uForward", forward.x, forward.y, forward.z);
   surfaceProgram.setBool("uPerspective", camera.projection() == Projection::Perspective);
   surfaceProgram.setBool("uSmooth", shading == Shading::Smooth);
+  surfaceProgram.setBool("uNormalMap", shading == Shading::NormalMap);
+  constexpr GLuint kNormalTextureUnit = 0;
+  surfaceProgram.setInt("uNormalTexture", kNormalTextureUnit);
+  if (shading == Shading::NormalMap) normalTexture.bind(kNormalTextureUnit);
   const float wireColor[4] = {shading::kWireColor[0], shading::kWireColor[1],
                               shading::kWireColor[2], 1.0f};
   const float background[4] = {shading::kBackground[0], shading::kBackground[1],
@@ -329,13 +336,19 @@ ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& 
     throw std::invalid_argument("raster: the supersample factor must not be negative");
   }
   validateOverlays(overlays);
+  const bool mapped = shading == Shading::NormalMap;
+  if (mapped && (!mesh.normalMap || mesh.texcoords.size() != mesh.positions.size())) {
+    throw std::invalid_argument(
+        "raster: normal-map shading needs a normal map and one texture coordinate per vertex");
+  }
   impl_->context.makeCurrent();
   ImageSet result;
   const bool frame = passes.color || passes.mask || passes.depth || passes.normal ||
                      passes.wireframe || !overlays.empty();
   if (!frame && passes.supersample == 0) return result;
 
-  impl_->mesh.upload(mesh);
+  impl_->mesh.upload(mesh, mapped);
+  if (mapped && frame) impl_->normalTexture.upload(*mesh.normalMap);
   if (!overlays.empty()) impl_->overlayLines.upload(overlays);
   if (frame) impl_->renderFrame(camera, passes, shading, overlays, result);
   if (passes.supersample > 0) impl_->renderCoverage(camera, passes.supersample, result);

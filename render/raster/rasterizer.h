@@ -17,8 +17,12 @@
 // stay visible; the others are drawn over everything.
 // Frames larger than the GL limits, and supersampled masks, are drawn in tiles with the same
 // sample positions. Shaders and GL objects are made once and reused; a mesh without normals is
-// shaded flat. Bad input (indices out of range, normals not one per vertex, an empty image
-// size, a malformed overlay: see validateOverlays in overlay_buffers.h) throws
+// shaded flat. Shading::NormalMap takes each pixel's normal from mesh.normalMap, sampled
+// bilinearly (no mipmaps, clamped to the edge) at the interpolated mesh.texcoords and
+// renormalised; it needs both (texcoords one per vertex) and a map no larger than
+// device().maxTextureSize, which is uploaded for every render. Bad input (indices out of
+// range, normals or texcoords not one per vertex, an empty image size, a malformed overlay: see
+// validateOverlays in overlay_buffers.h, normal-map shading without a map) throws
 // std::invalid_argument; GL failures throw std::runtime_error naming the step.
 #pragma once
 
@@ -39,6 +43,7 @@ struct DeviceInfo {
   std::string vendor;    // GL_VENDOR
   std::string version;   // GL_VERSION
   std::string eglPlatform;  // "device" or "surfaceless"
+  int maxTextureSize = 0;   // GL_MAX_TEXTURE_SIZE: the largest normal map side it can take
 };
 
 class Rasterizer {

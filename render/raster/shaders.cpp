@@ -36,15 +36,18 @@ std::string surfaceVertexShader() {
   return R"(#version 450 core
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
+layout(location = 2) in vec2 aTexcoord;
 uniform mat4 uViewProjection;
 uniform vec3 uEye;
 uniform vec3 uForward;
 out vec3 vFromEye;  // p - eye: small numbers near the eye keep the face normal precise
 out vec3 vNormal;
+out vec2 vTexcoord;
 out float vDepth;   // affine in p, so perspective-correct interpolation makes it exact
 void main() {
   vFromEye = aPosition - uEye;
   vNormal = aNormal;
+  vTexcoord = aTexcoord;
   vDepth = dot(vFromEye, uForward);
   gl_Position = uViewProjection * vec4(aPosition, 1.0);
 }
@@ -55,10 +58,13 @@ std::string surfaceFragmentShader() {
   return std::string(R"(#version 450 core
 in vec3 vFromEye;
 in vec3 vNormal;
+in vec2 vTexcoord;
 in float vDepth;
 uniform vec3 uForward;
 uniform bool uPerspective;
 uniform bool uSmooth;
+uniform bool uNormalMap;
+uniform sampler2D uNormalTexture;
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out float oDepth;
 layout(location = 2) out vec4 oNormal;
@@ -76,6 +82,13 @@ void main() {
   vec3 n = face;
   float smoothLength = length(vNormal);
   if (uSmooth && smoothLength > 0.0) n = vNormal / smoothLength;
+  if (uNormalMap) {
+    // Bilinear between texel normals, renormalised. Level 0 explicitly: there are no mipmaps,
+    // and implicit derivatives are undefined in this branch.
+    vec3 mapped = textureLod(uNormalTexture, vTexcoord, 0.0).xyz;
+    float mappedLength = length(mapped);
+    if (mappedLength > 0.0) n = mapped / mappedLength;
+  }
 
   // shading::shade(): headlight Blinn-Phong, the half vector is toEye.
   float ndotv = dot(n, toEye);

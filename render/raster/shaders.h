@@ -7,8 +7,11 @@
 namespace limn::render::raster {
 
 // The surface program: writes colour (location 0, shaded as shading::shade() does, alpha 1),
-// linear depth (location 1) and the world-space shading normal (location 2).
-// Uniforms: uViewProjection, uEye, uForward, uPerspective, uSmooth.
+// linear depth (location 1) and the world-space shading normal (location 2). The normal is the
+// face normal, or the interpolated vertex normal (uSmooth), or the normal map's bilinear sample
+// at the interpolated texture coordinate (uNormalMap), renormalised.
+// Attributes: aPosition (0), aNormal (1), aTexcoord (2).
+// Uniforms: uViewProjection, uEye, uForward, uPerspective, uSmooth, uNormalMap, uNormalTexture.
 std::string surfaceVertexShader();
 std::string surfaceFragmentShader();
 

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "render/core/image.h"
 #include "render/core/vec.h"
 
 namespace limn::render::tessellate {
@@ -28,6 +30,14 @@ struct TriangleMesh {
   // Edges to draw in the wireframe pass, two indices each; empty means "triangle edges".
   // Coarse and uniform meshes list their polygon edges so quads are drawn as quads.
   std::vector<uint32_t> lines;
+
+  // For Shading::NormalMap: per-vertex coordinates into normalMap, and the map itself (3
+  // channels, float, unit world-space normals; see render/normalmap/normal_atlas.h). Texture
+  // coordinates are in [0, 1]^2 with (0, 0) at the top-left corner of the image: s runs along
+  // a row, t down the rows (row 0 of the Image at t = 0), texel (i, j)'s centre at
+  // ((i + 0.5) / width, (j + 0.5) / height). Empty / null: no normal map.
+  std::vector<Vec2f> texcoords;
+  std::shared_ptr<const Image> normalMap;
 
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size(); }

@@ -1,6 +1,7 @@
 // Tests of render/raster: the headless EGL/OpenGL rasteriser against what the camera and the
 // shading model say each pixel must hold (coverage from Camera::project, linear depth, normals,
-// shading::shade colours, supersampled coverage, tiles, wireframe, line overlays, threads).
+// shading::shade colours, supersampled coverage, tiles, wireframe, line overlays, normal maps,
+// threads).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -1007,6 +1009,104 @@ TEST_F(RasterTest, RejectsMalformedOverlays) {
                                         {empty, good});
   EXPECT_EQ(images.passes.at("empty").pixels, images.passes.at(pass::kColor).pixels);
   EXPECT_EQ(images.passes.size(), 4u);
+}
+
+// ---- Normal-map shading ----
+
+// A W x H normal map whose normals turn smoothly with s and t (differently in each), so a
+// flipped or shifted lookup would show.
+std::shared_ptr<const Image> smoothNormalMap(int width, int height) {
+  auto map = std::make_shared<Image>(width, height, 3);
+  for (int j = 0; j < height; ++j) {
+    for (int i = 0; i < width; ++i) {
+      const double s = (i + 0.5) / width, t = (j + 0.5) / height;
+      Vec3 n = normalize(Vec3{0.6 * s - 0.2, 0.5 * t * t - 0.3, 1.0});
+      for (int k = 0; k < 3; ++k) map->at(i, j, k) = static_cast<float>(n[k]);
+    }
+  }
+  return map;
+}
+
+// What GL_LINEAR with clamp-to-edge reads at (s, t), renormalised.
+Vec3 bilinearNormal(const Image& map, double s, double t) {
+  const double x = s * map.width - 0.5, y = t * map.height - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  auto texel = [&](int i, int j) {
+    i = std::clamp(i, 0, map.width - 1);
+    j = std::clamp(j, 0, map.height - 1);
+    return Vec3{map.at(i, j, 0), map.at(i, j, 1), map.at(i, j, 2)};
+  };
+  return normalize((texel(x0, y0) * (1 - fx) + texel(x0 + 1, y0) * fx) * (1 - fy) +
+                   (texel(x0, y0 + 1) * (1 - fx) + texel(x0 + 1, y0 + 1) * fx) * fy);
+}
+
+TEST_F(RasterTest, NormalMapShadingSamplesTheMapBilinearly) {
+  // The tilted quad is a rectangle, so its texture coordinates are affine over all of it:
+  // s along kQuad[0] -> kQuad[1], t along kQuad[0] -> kQuad[3].
+  TriangleMesh mesh = tiltedQuad();
+  mesh.texcoords = {Vec2f{0, 0}, Vec2f{1, 0}, Vec2f{1, 1}, Vec2f{0, 1}};
+  mesh.normalMap = smoothNormalMap(7, 5);
+  const Vec3 e1 = kQuad[1] - kQuad[0], e2 = kQuad[3] - kQuad[0];
+  for (const Camera& camera : {perspectiveCamera(80, 60), orthographicCamera(80, 60)}) {
+    ImageSet images = rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap);
+    const Image& normal = images.passes.at(pass::kNormal);
+    const Image& color = images.passes.at(pass::kColor);
+    int checked = 0;
+    double worst = 0;
+    for (int y = 0; y < camera.height(); ++y) {
+      for (int x = 0; x < camera.width(); ++x) {
+        if (insideDistance(camera, quadCorners(), x + 0.5, y + 0.5) < 0.01) continue;
+        Vec3 hit;
+        ASSERT_TRUE(hitQuadPlane(camera, x + 0.5, y + 0.5, hit));
+        const double s = dot(hit - kQuad[0], e1) / dot(e1, e1);
+        const double t = dot(hit - kQuad[0], e2) / dot(e2, e2);
+        const Vec3 expected = bilinearNormal(*mesh.normalMap, s, t);
+        const Vec3 got{normal.at(x, y, 0), normal.at(x, y, 1), normal.at(x, y, 2)};
+        EXPECT_NEAR(length(got), 1.0, 1e-5);
+        worst = std::max(worst, length(got - expected));
+        Vec3 toEye = camera.projection() == Projection::Perspective
+                         ? normalize(camera.eye() - hit)
+                         : -camera.forward();
+        float rgb[3];
+        shading::shade(got, toEye, rgb);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(color.at(x, y, k), rgb[k], 1e-4);
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 500);
+    // Neighbouring texels differ by about 0.1: a lookup off by a texel, or flipped, is 1e-1 off;
+    // GPUs weigh bilinear samples with 8 fractional bits (~0.1 / 256).
+    std::printf("normal-map lookup: worst normal error %.2e over %d pixels\n", worst, checked);
+    EXPECT_LT(worst, 2e-3);
+  }
+}
+
+TEST_F(RasterTest, NormalMapShadingNeedsTheMapAndTexcoords) {
+  const Camera camera = perspectiveCamera();
+  TriangleMesh mesh = tiltedQuad();
+  EXPECT_THROW(rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap),
+               std::invalid_argument);
+  mesh.normalMap = smoothNormalMap(4, 4);
+  EXPECT_THROW(rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap),
+               std::invalid_argument);
+  mesh.texcoords = {Vec2f{0, 0}, Vec2f{1, 0}, Vec2f{1, 1}};
+  EXPECT_THROW(rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap),
+               std::invalid_argument);
+  mesh.texcoords.push_back(Vec2f{0, 1});
+  mesh.normalMap = std::make_shared<Image>(4, 4, 4, 0.5f);
+  EXPECT_THROW(rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap),
+               std::invalid_argument);
+  const int tooLarge = rasterizer().device().maxTextureSize + 1;
+  ASSERT_GT(tooLarge, 1);
+  mesh.normalMap = std::make_shared<Image>(tooLarge, 1, 3, 0.5f);
+  EXPECT_THROW(rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap),
+               std::invalid_argument);
+  // The other shadings ignore a bad map, and the rasteriser is still usable.
+  expectTiltedQuad(rasterizer().render(mesh, camera, allPasses(), Shading::Flat), camera);
+  mesh.normalMap = smoothNormalMap(4, 4);
+  ImageSet images = rasterizer().render(mesh, camera, allPasses(), Shading::NormalMap);
+  EXPECT_GT(images.passes.at(pass::kNormal).at(32, 24, 2), 0.9f);
 }
 
 TEST(RasterThreads, TwoRasterizersOnTwoThreads) {
