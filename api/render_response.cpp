@@ -127,6 +127,9 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
   count("correctedFaces", s.correctedFaces);
   count("curveSamples", s.curveSamples);
   count("unresolvedSamples", s.unresolvedSamples);
+  count("refinedEdges", s.refinedEdges);
+  count("refinedFaces", s.refinedFaces);
+  count("interiorSplits", s.interiorSplits);
   count("trianglesAdded", s.trianglesAdded);
   count("trianglesDrawn", s.trianglesDrawn);
   w.EndObject();

@@ -4,7 +4,11 @@
 
 #include "render/core/error.h"
 #include "render/core/parallel.h"
+#include "render/silhouette/chord_refinement.h"
+#include "render/silhouette/face_refinement.h"
 #include "render/silhouette/face_triangulation.h"
+
+#include <opensubdiv/bfr/tessellation.h>
 
 namespace limn::render::silhouette {
 
@@ -17,16 +21,56 @@ struct FacePiece {
   std::vector<ContourCurve> curves;
   bool corrected = false;
   size_t coarseTriangles = 0, curveSamples = 0, unresolved = 0;
+  int splits = 0;
   bool odd = false;
 };
 
+// A ring face refined by refineConcaveChords: Bfr's tessellation with the face's edge rates
+// and an inner rate. Its boundary points are exactly the face's (corner 0, the points of edge
+// 0, corner 1, ...) when every edge carries only its uniform points; false otherwise.
+bool tessellateRingFace(const subdiv::LimitSurface& surface, const ContourSearch& search,
+                        const ChordRefinement& chords, const FaceBoundary& boundary,
+                        FacePiece& piece) {
+  namespace Bfr = OpenSubdiv::Bfr;
+  const int face = boundary.face;
+  OpenSubdiv::Far::ConstIndexArray edges = surface.baseLevel().GetFaceEdges(face);
+  std::vector<int> rates;
+  for (int e : edges) {
+    int rate = std::max(1, chords.edgeRates[e]);
+    if (search.edgePoints[e].size() != static_cast<size_t>(rate - 1)) return false;
+    rates.push_back(rate);
+  }
+  rates.push_back(chords.interiorRates[face]);
+  Bfr::Tessellation tess(surface.parameterization(face), static_cast<int>(rates.size()),
+                         rates.data());
+  if (tess.GetNumBoundaryCoords() != static_cast<int>(boundary.points.size())) return false;
+  std::vector<double> coords(2 * tess.GetNumCoords());
+  tess.GetCoords(coords.data());
+  for (int i = tess.GetNumBoundaryCoords(); i < tess.GetNumCoords(); ++i) {
+    subdiv::LimitSample s = surface.evaluate(face, coords[2 * i], coords[2 * i + 1]);
+    piece.points.push_back({{coords[2 * i], coords[2 * i + 1]}, s.position, s.normal});
+  }
+  std::vector<int> facets(3 * tess.GetNumFacets());
+  tess.GetFacets(facets.data());
+  for (size_t i = 0; i < facets.size(); i += 3) {
+    piece.triangles.push_back({facets[i], facets[i + 1], facets[i + 2]});
+  }
+  return true;
+}
+
 FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
-                    const ContourSearch& search, const SilhouetteOptions& options, int face) {
+                    const ContourSearch& search, const ChordRefinement& chords,
+                    const SilhouetteOptions& options, int face) {
   FacePiece piece;
   FaceBoundary boundary = faceBoundary(surface, search, face);
   const int corners = static_cast<int>(boundary.points.size()) - boundary.edgePointCount;
   piece.coarseTriangles = static_cast<size_t>(corners - 2);
   piece.points = boundary.points;
+  if (chords.interiorRates[face] >= 2) {
+    piece.corrected = true;
+    if (tessellateRingFace(surface, search, chords, boundary, piece)) return piece;
+    piece.points = boundary.points;  // fall back to clipping the boundary alone
+  }
   if (boundary.edgePointCount == 0) {
     for (int k = 1; k + 1 < corners; ++k) piece.triangles.push_back({0, k, k + 1});
     return piece;
@@ -58,6 +102,21 @@ FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
   uv.reserve(piece.points.size());
   for (const FacePoint& p : piece.points) uv.push_back(p.uv);
   piece.triangles = triangulateFace(uv, static_cast<int>(boundary.points.size()), paths);
+  // Only exact curves lie on the surface; a chord ending at a pn sample (off the surface) would
+  // never come within tolerance, so pn faces keep their ear-clipped triangles.
+  if (!paths.empty() && options.curves.mode == CurveMode::Exact) {
+    std::vector<std::vector<int>> chains;
+    for (const CurvePath& path : paths) {
+      std::vector<int> chain{path.from};
+      chain.insert(chain.end(), path.interior.begin(), path.interior.end());
+      chain.push_back(path.to);
+      chains.push_back(std::move(chain));
+    }
+    piece.splits = refineFaceTriangles(surface, camera, face,
+                                       static_cast<int>(boundary.points.size()), chains,
+                                       options.chords.tolerancePx, options.chords.maxFaceSplits,
+                                       piece.points, piece.triangles);
+  }
   return piece;
 }
 
@@ -68,6 +127,11 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
   SilhouetteMesh out;
   out.search = searchContour(surface, camera, options.search, cancel);
   out.stats.search = out.search.stats;
+  const ChordRefinement chords =
+      refineConcaveChords(surface, camera, contourFaces(surface, out.search), options.chords,
+                          out.search);
+  out.stats.refinedEdges = chords.refinedEdges;
+  out.stats.refinedFaces = chords.refinedFaces;
 
   const int faceCount = surface.faceCount();
   std::vector<FacePiece> pieces(faceCount);
@@ -75,7 +139,7 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
     for (size_t f = begin; f < end; ++f) {
       if ((f & 63) == 0) cancel.check();
       if (!surface.hasLimit(static_cast<int>(f))) continue;
-      pieces[f] = buildFace(surface, camera, out.search, options, static_cast<int>(f));
+      pieces[f] = buildFace(surface, camera, out.search, chords, options, static_cast<int>(f));
     }
   });
   cancel.check();
@@ -119,6 +183,7 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
       }
     }
     out.stats.curveSamples += piece.curveSamples;
+    out.stats.interiorSplits += piece.splits;
     out.stats.unresolvedSamples += piece.unresolved;
     if (piece.odd) ++out.stats.oddFaces;
     for (ContourCurve& c : piece.curves) out.curves.push_back(std::move(c));

@@ -5,6 +5,7 @@
 //
 //   searchContour   edges -> edge points where g = dot(n, p - eye) changes sign
 //   faceCurves      per face: crossings paired, curves sampled ("pn" or "exact")
+//   refineConcaveChords  one ring out: points where a chord would lie outside the surface
 //   triangulateFace per face with edge points: regions cut by the curves, ear-clipped in (u, v)
 // Faces with no edge point keep their corners: quads as two triangles, triangles as one.
 #pragma once
@@ -13,6 +14,7 @@
 
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
+#include "render/silhouette/chord_refinement.h"
 #include "render/silhouette/contour_search.h"
 #include "render/silhouette/face_contour.h"
 #include "render/subdiv/limit_surface.h"
@@ -23,6 +25,7 @@ namespace limn::render::silhouette {
 struct SilhouetteOptions {
   SearchOptions search;
   CurveOptions curves;
+  ChordOptions chords;
   size_t maxTriangles = 8'000'000;
 };
 
@@ -38,6 +41,9 @@ struct SilhouetteStats {
   SearchStats search;
   size_t contourFaces = 0;    // faces holding at least one contour curve
   size_t correctedFaces = 0;  // faces re-triangulated (contour faces and their edge neighbours)
+  size_t refinedEdges = 0;    // edges given points because their chord lay outside (concave)
+  size_t refinedFaces = 0;    // ring faces given interior points for the same reason
+  size_t interiorSplits = 0;  // contour-face edges split because their chord lay outside
   size_t trianglesAdded = 0;  // triangles drawn beyond the coarse mesh's
   size_t trianglesDrawn = 0;
   size_t curveSamples = 0;

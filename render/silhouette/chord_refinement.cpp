@@ -1,0 +1,118 @@
+#include "render/silhouette/chord_refinement.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/core/parallel.h"
+
+namespace limn::render::silhouette {
+
+namespace Far = OpenSubdiv::Far;
+
+namespace {
+
+// Segments that bring a sag of `sagPx` under `tolerancePx` (sag ~ 1 / segments^2).
+int segmentsFor(double sagPx, const ChordOptions& options) {
+  if (!(sagPx > options.tolerancePx)) return 1;
+  int n = static_cast<int>(std::ceil(std::sqrt(sagPx / options.tolerancePx)));
+  return std::clamp(n, 2, std::max(2, options.maxSegments));
+}
+
+// How far `chordPoint` lies outside the surface at `sample`, in pixels (0 when inside).
+double outsidePixels(const Camera& camera, const Vec3& chordPoint,
+                     const subdiv::LimitSample& sample) {
+  if (dot(chordPoint - sample.position, sample.normal) <= 0) return 0;
+  Vec3 a = camera.project(chordPoint), b = camera.project(sample.position);
+  return std::hypot(a.x - b.x, a.y - b.y);
+}
+
+}  // namespace
+
+std::vector<bool> contourFaces(const subdiv::LimitSurface& surface, const ContourSearch& search) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  std::vector<bool> out(surface.faceCount(), false);
+  for (int e = 0; e < base.GetNumEdges(); ++e) {
+    Far::ConstIndexArray faces = base.GetEdgeFaces(e);
+    for (const EdgePoint& p : search.edgePoints[e]) {
+      for (int k = 0; k < faces.size() && k < 32; ++k) {
+        if (p.sides >> k & 1u) out[faces[k]] = true;
+      }
+    }
+  }
+  return out;
+}
+
+ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const Camera& camera,
+                                    const std::vector<bool>& contourFace,
+                                    const ChordOptions& options, ContourSearch& search) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  const std::vector<Vec3>& limit = surface.controlLimitPositions();
+  ChordRefinement out;
+  out.edgeRates.assign(base.GetNumEdges(), 0);
+  out.interiorRates.assign(surface.faceCount(), 0);
+
+  // The contour faces and the ring of faces sharing a vertex with them.
+  std::vector<bool> near(surface.faceCount(), false);
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!contourFace[f]) continue;
+    for (int v : base.GetFaceVertices(f)) {
+      for (int g : base.GetVertexFaces(v)) near[g] = true;
+    }
+  }
+  std::vector<bool> candidate(base.GetNumEdges(), false);
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!near[f] || !surface.hasLimit(f)) continue;
+    for (int e : base.GetFaceEdges(f)) candidate[e] = true;
+  }
+
+  parallelFor(base.GetNumEdges(), 64, [&](size_t begin, size_t end) {
+    for (size_t e = begin; e < end; ++e) {
+      if (!candidate[e]) continue;
+      std::vector<EdgePoint>& points = search.edgePoints[e];
+      bool outline = std::any_of(points.begin(), points.end(),
+                                 [](const EdgePoint& p) { return p.sides == 0; });
+      if (outline) continue;
+      int owner = -1;
+      for (int f : base.GetEdgeFaces(static_cast<int>(e))) {
+        if (surface.hasLimit(f)) {
+          owner = f;
+          break;
+        }
+      }
+      if (owner < 0) continue;
+      Far::ConstIndexArray ends = base.GetEdgeVertices(static_cast<int>(e));
+      Vec2 uv = edgeUV(surface, owner, static_cast<int>(e), 0.5);
+      subdiv::LimitSample mid = surface.evaluate(owner, uv.x, uv.y);
+      int segments = segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), mid),
+                                 options);
+      if (segments < 2) continue;
+      out.edgeRates[e] = segments;
+      for (int i = 1; i < segments; ++i) {
+        double t = static_cast<double>(i) / segments;
+        Vec2 at = edgeUV(surface, owner, static_cast<int>(e), t);
+        points.push_back({t, surface.position(owner, at.x, at.y), 0u});
+      }
+      std::sort(points.begin(), points.end(),
+                [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
+    }
+  });
+  for (int rate : out.edgeRates) out.refinedEdges += rate > 0;
+
+  // Interiors of ring faces (contour faces are cut by their curves instead).
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!near[f] || contourFace[f] || !surface.hasLimit(f)) continue;
+    Vec3 centroid{0, 0, 0};
+    Far::ConstIndexArray verts = base.GetFaceVertices(f);
+    for (int v : verts) centroid += limit[v];
+    centroid = centroid / static_cast<double>(verts.size());
+    Vec2 c = surface.centerUV(f);
+    int rate = segmentsFor(outsidePixels(camera, centroid, surface.evaluate(f, c.x, c.y)), options);
+    for (int e : base.GetFaceEdges(f)) rate = std::max(rate, out.edgeRates[e]);
+    if (rate < 2) continue;
+    out.interiorRates[f] = rate;
+    ++out.refinedFaces;
+  }
+  return out;
+}
+
+}  // namespace limn::render::silhouette

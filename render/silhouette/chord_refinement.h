@@ -1,0 +1,42 @@
+// Concave contours (part of step 4 of the silhouette method). The coarse faces are flat
+// triangles through points of the limit surface; where the surface is concave along an edge,
+// the chord lies OUTSIDE it, and next to the contour such a chord either pokes past the exact
+// outline (into a torus's hole, say) or hides part of it. The correction is propagated one
+// ring out from the contour faces: every edge of a contour face or of a face sharing a vertex
+// with one whose chord lies outside the surface by more than `tolerancePx` (projected) gets
+// uniform points along its limit curve, enough to bring the chord's sag under the tolerance
+// (sag falls with the square of the segment count); such ring faces whose centre lies outside
+// the surface likewise get interior points. Chords inside the surface (convex regions) stay:
+// the exact contour curves already bound the outline there.
+#pragma once
+
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/silhouette/contour_search.h"
+#include "render/subdiv/limit_surface.h"
+
+namespace limn::render::silhouette {
+
+struct ChordOptions {
+  double tolerancePx = 0.25;
+  int maxSegments = 32;  // per edge, and per side of a face's interior
+  int maxFaceSplits = 64;  // interior edge splits per contour face (face_refinement.h)
+};
+
+struct ChordRefinement {
+  std::vector<int> edgeRates;      // per base edge: uniform segments added (0: none)
+  std::vector<int> interiorRates;  // per face: inner tessellation rate (0: none)
+  size_t refinedEdges = 0, refinedFaces = 0;
+};
+
+// True when face `face` holds a crossing of g on one of its edges (as seen from that face).
+std::vector<bool> contourFaces(const subdiv::LimitSurface& surface, const ContourSearch& search);
+
+// Adds the uniform points to search.edgePoints (as points with no crossing) and returns the
+// rates it chose. Outline edges (which already carry uniform points) are left as they are.
+ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const Camera& camera,
+                                    const std::vector<bool>& contourFace,
+                                    const ChordOptions& options, ContourSearch& search);
+
+}  // namespace limn::render::silhouette

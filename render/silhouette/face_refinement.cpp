@@ -1,0 +1,89 @@
+#include "render/silhouette/face_refinement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <utility>
+
+namespace limn::render::silhouette {
+
+namespace {
+
+using Edge = std::pair<int, int>;
+Edge key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
+
+}  // namespace
+
+int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camera, int face,
+                        int boundaryCount, const std::vector<std::vector<int>>& lockedChains,
+                        double tolerancePx, int maxSplits, std::vector<FacePoint>& points,
+                        std::vector<std::array<int, 3>>& triangles) {
+  std::set<Edge> locked;
+  for (int i = 0; i < boundaryCount; ++i) locked.insert(key(i, (i + 1) % boundaryCount));
+  for (const std::vector<int>& chain : lockedChains) {
+    for (size_t i = 0; i + 1 < chain.size(); ++i) locked.insert(key(chain[i], chain[i + 1]));
+  }
+
+  // How far the chord a-b lies outside the surface at its middle, in pixels (0 if inside).
+  auto sag = [&](int a, int b, FacePoint* middle) {
+    const FacePoint& pa = points[a];
+    const FacePoint& pb = points[b];
+    Vec2 uv{0.5 * (pa.uv.x + pb.uv.x), 0.5 * (pa.uv.y + pb.uv.y)};
+    subdiv::LimitSample s = surface.evaluate(face, uv.x, uv.y);
+    *middle = {uv, s.position, s.normal};
+    Vec3 chord = 0.5 * (pa.position + pb.position);
+    if (dot(chord - s.position, s.normal) <= 0) return 0.0;
+    Vec3 c = camera.project(chord), m = camera.project(s.position);
+    return std::hypot(c.x - m.x, c.y - m.y);
+  };
+
+  int splits = 0;
+  std::set<Edge> checked;  // interior edges found fine (their chord is within tolerance)
+  while (splits < maxSplits) {
+    // Find the worst interior edge still over tolerance.
+    double worst = tolerancePx;
+    Edge target{-1, -1};
+    FacePoint targetMiddle;
+    for (const auto& t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        Edge e = key(t[k], t[(k + 1) % 3]);
+        if (locked.count(e) || checked.count(e)) continue;
+        const Vec2 &ua = points[e.first].uv, &ub = points[e.second].uv;
+        if (std::hypot(ua.x - ub.x, ua.y - ub.y) < 1e-6) {  // too short to split further
+          checked.insert(e);
+          continue;
+        }
+        FacePoint middle;
+        double s = sag(e.first, e.second, &middle);
+        if (s > worst) {
+          worst = s;
+          target = e;
+          targetMiddle = middle;
+        } else if (s <= tolerancePx) {
+          checked.insert(e);
+        }
+      }
+    }
+    if (target.first < 0) break;
+
+    // Split it: each triangle (a, b, c) on the edge becomes (a, m, c) and (m, b, c).
+    const int m = static_cast<int>(points.size());
+    points.push_back(targetMiddle);
+    const size_t count = triangles.size();
+    for (size_t i = 0; i < count; ++i) {
+      std::array<int, 3> t = triangles[i];
+      for (int k = 0; k < 3; ++k) {
+        int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+        if (key(a, b) != target) continue;
+        triangles[i] = {a, m, c};
+        triangles.push_back({m, b, c});
+        break;
+      }
+    }
+    ++splits;
+  }
+  return splits;
+}
+
+}  // namespace limn::render::silhouette
