@@ -1,6 +1,7 @@
 #include "render/silhouette/contour_polylines.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 
@@ -108,6 +109,12 @@ class Chainer {
 std::vector<ContourPolyline> chainContourCurves(const std::vector<ContourCurve>& curves,
                                                 const Camera& camera) {
   return Chainer(curves, camera).chainAll();
+}
+
+double distanceFromSurface(const subdiv::LimitSurface& surface, const PolylinePoint& point) {
+  if (point.face < 0 || !surface.hasLimit(point.face)) return 0.0;
+  subdiv::LimitSample s = surface.evaluate(point.face, point.uv.x, point.uv.y);
+  return std::fabs(dot(point.position - s.position, s.normal));
 }
 
 std::vector<PolylinePiece> splitPieces(ContourPolyline& polyline, std::vector<bool>& visible) {

@@ -17,6 +17,7 @@
 
 #include "render/core/camera.h"
 #include "render/silhouette/silhouette_mesh.h"
+#include "render/subdiv/limit_surface.h"
 
 namespace limn::render::silhouette {
 
@@ -42,6 +43,12 @@ struct ContourPolyline {
 // within each kind, in the order of their first curve.
 std::vector<ContourPolyline> chainContourCurves(const std::vector<ContourCurve>& curves,
                                                 const Camera& camera);
+
+// How far the point is from the limit surface along the surface normal at its (face, u, v):
+// 0 up to rounding for "exact" samples and edge points, the curve's departure from the surface
+// for "pn" samples and for exact samples left on the chord. Visibility tests widen their
+// tolerance by it (oracle/visibility.h).
+double distanceFromSurface(const subdiv::LimitSurface& surface, const PolylinePoint& point);
 
 // A maximal run of points with the same visibility: points [start, end] of a polyline.
 struct PolylinePiece {
