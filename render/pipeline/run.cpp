@@ -4,7 +4,10 @@
 #include "render/core/error.h"
 #include "render/oracle/reference.h"
 #include "render/pipeline/render_job.h"
+#include "render/pipeline/silhouette_build.h"
 #include "render/raster/rasterizer.h"
+#include "render/normalmap/mapped_cage.h"
+#include "render/normalmap/normal_atlas.h"
 #include "render/silhouette/contour_overlay.h"
 #include "render/subdiv/limit_surface.h"
 #include "render/tessellate/tessellate.h"
@@ -32,6 +35,11 @@ class Stopwatch {
 
 void checkJob(const RenderJob& job, const JobLimits& limits) {
   const MethodParams& p = job.params;
+  if (job.shading == Shading::NormalMap && job.method != Method::Silhouette &&
+      job.method != Method::Coarse) {
+    badParameter("shading", "\"normal-map\" is available with methods \"silhouette\" and "
+                            "\"coarse\" (the others draw limit normals per vertex)");
+  }
   if (p.level < 0 || p.level > limits.maxLevel) {
     badParameter("params.level", "must be in 0.." + std::to_string(limits.maxLevel));
   }
@@ -58,11 +66,40 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
   }
 }
 
+// Normal-map shading: an atlas of the limit normals of `surface`'s faces, sized so the face
+// that looks largest gets about half a texel per pixel (bilinear filtering does the rest),
+// with at most 64 x 64 texels per face and 4M texels in all.
+normalmap::NormalAtlas makeAtlas(const subdiv::LimitSurface& surface, const Camera& camera) {
+  constexpr size_t kTexelBudget = size_t{1} << 22;
+  constexpr int kMaxSide = 4096, kMaxChartTexels = 64;
+  int texels = normalmap::chartTexelsForCamera(surface, camera, 0.5, kTexelBudget, kMaxSide,
+                                               kMaxChartTexels);
+  return normalmap::NormalAtlas(surface, texels, kMaxSide);
+}
+
+// Atlas coordinates for a mesh whose vertices each belong to one face (the silhouette mesh):
+// read off the face and (u, v) its triangles record.
+void mapNormals(tessellate::TriangleMesh& mesh, const normalmap::NormalAtlas& atlas) {
+  mesh.texcoords.assign(mesh.positions.size(), Vec2f{});
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec2f& uv = mesh.cornerUVs[3 * t + k];
+      mesh.texcoords[mesh.indices[3 * t + k]] =
+          atlas.coordinate(mesh.triangleFaces[t], Vec2{uv.x, uv.y});
+    }
+  }
+  mesh.normalMap = atlas.image();
+}
+
 tessellate::TriangleMesh approximate(const RenderJob& job, const JobLimits& limits,
                                      const subdiv::LimitSurface& surface, const Camera& camera,
                                      const CancelToken& cancel) {
   switch (job.method) {
-    case Method::Coarse: return tessellate::tessellateCoarse(surface);
+    case Method::Coarse:
+      if (job.shading == Shading::NormalMap) {
+        return normalmap::mappedCage(surface, makeAtlas(surface, camera));
+      }
+      return tessellate::tessellateCoarse(surface);
     case Method::Uniform:
       return tessellate::tessellateUniform(surface, job.params.level, limits.maxTriangles);
     case Method::Adaptive: {
@@ -84,41 +121,14 @@ silhouette::SilhouetteMesh runSilhouette(const RenderJob& job, const JobLimits& 
                                          const Camera& camera, const CancelToken& cancel,
                                          std::unique_ptr<subdiv::LimitSurface>& drawn,
                                          RenderResult& result) {
-  using silhouette::Presubdivide;
-  bool refine = job.params.presubdivide == Presubdivide::Once;
-  if (job.params.presubdivide == Presubdivide::Auto) {
-    refine = !silhouette::presubdivisionReason(job.mesh).empty();
-  }
-  if (!refine && !silhouette::hasSimpleFaces(job.mesh)) {
-    refine = true;
-    result.warnings.push_back(
-        "params.presubdivide 0 overridden: the silhouette method triangulates quads "
-        "(Catmull-Clark) or triangles (Loop) only, so the mesh was refined once");
-  }
-  const subdiv::LimitSurface* base = &surface;
-  if (refine) {
-    drawn = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(job.mesh));
-    base = drawn.get();
-  }
-  result.stats.presubdivided = refine;
-  silhouette::SilhouetteOptions options;
-  options.search.searchSteps = job.params.searchSteps;
-  options.search.outlineSamples = job.params.curveSamples;
-  options.curves.curveSamples = job.params.curveSamples;
-  options.curves.mode = job.params.contour;
-  options.maxTriangles = limits.maxTriangles;
-  silhouette::SilhouetteMesh out = silhouette::buildSilhouetteMesh(*base, camera, options, cancel);
-  if (out.stats.oddFaces > 0) {
-    result.warnings.push_back(std::to_string(out.stats.oddFaces) +
-                              " faces had an odd number of contour crossings and were drawn "
-                              "without a contour curve");
-  }
-  if (out.stats.unresolvedSamples > 0) {
-    result.warnings.push_back(std::to_string(out.stats.unresolvedSamples) +
-                              " exact contour samples found no root and stayed on the chord");
-  }
-  result.stats.silhouette = out.stats;
-  return out;
+  const MethodParams& p = job.params;
+  SilhouetteBuild build =
+      buildSilhouette(surface, camera, {p.presubdivide, p.searchSteps, p.curveSamples, p.contour},
+                      limits.maxTriangles, cancel, result.warnings);
+  drawn = std::move(build.presubdivided);
+  result.stats.presubdivided = drawn != nullptr;
+  result.stats.silhouette = build.built.stats;
+  return std::move(build.built);
 }
 
 // Keeps only the passes the client asked for; the wireframe of the reference is its colour
@@ -187,6 +197,9 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
           presubdivided ? *presubdivided : surface, built, pass::kContours));
     }
     approx = std::move(built.mesh);
+    if (job.shading == Shading::NormalMap) {
+      mapNormals(*approx, makeAtlas(presubdivided ? *presubdivided : surface, camera));
+    }
   } else if (job.method != Method::Limit) {
     approx = approximate(job, limits, surface, camera, cancel);
   }

@@ -1,0 +1,44 @@
+#include "render/pipeline/silhouette_build.h"
+
+namespace limn::render::pipeline {
+
+SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camera& camera,
+                                const SilhouetteParams& params, size_t maxTriangles,
+                                const CancelToken& cancel, std::vector<std::string>& warnings) {
+  using silhouette::Presubdivide;
+  const mesh::ControlMesh& mesh = surface.mesh();
+  bool refine = params.presubdivide == Presubdivide::Once;
+  if (params.presubdivide == Presubdivide::Auto) {
+    refine = !silhouette::presubdivisionReason(mesh).empty();
+  }
+  if (!refine && !silhouette::hasSimpleFaces(mesh)) {
+    refine = true;
+    warnings.push_back(
+        "params.presubdivide 0 overridden: the silhouette method triangulates quads "
+        "(Catmull-Clark) or triangles (Loop) only, so the mesh was refined once");
+  }
+  SilhouetteBuild out;
+  if (refine) out.presubdivided = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh));
+
+  silhouette::SilhouetteOptions options;
+  options.search.searchSteps = params.searchSteps;
+  options.search.outlineSamples = params.curveSamples;
+  options.curves.curveSamples = params.curveSamples;
+  options.curves.mode = params.contour;
+  options.maxTriangles = maxTriangles;
+  out.built = silhouette::buildSilhouetteMesh(out.drawn(surface), camera, options, cancel);
+
+  const silhouette::SilhouetteStats& stats = out.built.stats;
+  if (stats.oddFaces > 0) {
+    warnings.push_back(std::to_string(stats.oddFaces) +
+                       " faces had an odd number of contour crossings and were drawn "
+                       "without a contour curve");
+  }
+  if (stats.unresolvedSamples > 0) {
+    warnings.push_back(std::to_string(stats.unresolvedSamples) +
+                       " exact contour samples found no root and stayed on the chord");
+  }
+  return out;
+}
+
+}  // namespace limn::render::pipeline
