@@ -110,7 +110,7 @@ Vec3 unitCross(const Tangents& t) { return normalize(cross(t.t1, t.t2)); }
 
 struct VertexLimit {
   Vec3 position;
-  Tangents tangents;       // of the side of the ring's first face
+  Tangents tangents;       // the vertex's own: see limit.h
   VertexRing ring;
   std::vector<Vec3> face;  // normal per face of the ring
 };
@@ -167,7 +167,8 @@ VertexLimit limitAt(const Topology& t, const std::vector<Vec3>& P, int v) {
       const Tangents tangents = creaseTangents(scheme, s);
       const Vec3 normal = unitCross(tangents);
       for (int i = first; i < last; ++i) out.face[i % faces] = normal;
-      if ((side == 0) == (sharp[0] == 0)) out.tangents = tangents;  // the side holding face 0
+      // OpenSubdiv's convention: the side counter-clockwise from the first sharp edge.
+      if (side == 0) out.tangents = tangents;
     }
     return out;
   }

@@ -21,8 +21,10 @@
 //
 // Where the limit normal is not unique -- a vertex on an interior crease (one tangent plane on
 // each side) or a corner (each face sees its own plane) -- each face corner gets the normal of
-// its side (cornerNormals), and the vertex's own normal is that of its first face in
-// orderedRing() order. OpenSubdiv also returns one of these, chosen by its own face order.
+// its side (cornerNormals). The vertex's own tangents follow OpenSubdiv's convention over the
+// orderedRing() order: at a crease, the side counter-clockwise from the first sharp edge to
+// the second; at a corner, the ring's first face. Where OpenSubdiv's ring starts elsewhere
+// (its own face order at refined levels) it returns another of the corner normals.
 #pragma once
 
 #include <vector>

@@ -27,6 +27,49 @@ void inheritTags(const Topology& p, int firstHalf, Topology& c) {
   for (int v = 0; v < p.vertexCount; ++v) c.vertexSharpness[v] = decaySharpness(p.vertexSharpness[v]);
 }
 
+// The child of parent face f at its corner k.
+using ChildFace = int (*)(const Topology& p, int f, int k);
+int quadChild(const Topology& p, int f, int k) { return p.faceOffsets[f] + k; }
+int triangleChild(const Topology&, int f, int k) { return 4 * f + k; }
+
+// Far's order of the faces around the child level's edges and vertices, which decides where
+// a vertex's ring starts (limit tangents at creases and corners follow it): each half of a
+// parent edge lists its faces in the parent edge's order; a child vertex of a vertex starts at
+// the child of its parent's first face, a face point at the face's first child, and an edge
+// point at the child, in the edge's first face, at the corner the face's winding runs the edge
+// to. (Edges inside faces are ordered by the caller.)
+void orderLikeFar(const Topology& p, int firstHalf, ChildFace child, int firstEdgeChild,
+                  int firstFaceChild, Topology& c) {
+  for (int e = 0; e < p.edgeCount(); ++e) {
+    std::span<const int> parentFaces = p.edgeFacesOf(e);
+    for (int end = 0; end < 2; ++end) {
+      const int v = p.edgeVertices[e][end], half = firstHalf + 2 * e + end;
+      for (size_t i = 0; i < parentFaces.size(); ++i) {
+        c.edgeFaces[c.edgeFaceOffsets[half] + i] = child(p, parentFaces[i], p.cornerOf(parentFaces[i], v));
+      }
+    }
+  }
+  c.ringStart.assign(c.vertexCount, -1);
+  for (int v = 0; v < p.vertexCount; ++v) {
+    std::span<const int> faces = p.vertexFacesOf(v);
+    if (faces.empty()) continue;
+    const int first = p.ringStart.empty() || p.ringStart[v] < 0 ? faces[0] : p.ringStart[v];
+    c.ringStart[v] = child(p, first, p.cornerOf(first, v));
+  }
+  if (firstFaceChild >= 0) {
+    for (int f = 0; f < p.faceCount(); ++f) c.ringStart[firstFaceChild + f] = child(p, f, 0);
+  }
+  for (int e = 0; e < p.edgeCount(); ++e) {
+    std::span<const int> faces = p.edgeFacesOf(e);
+    if (faces.empty()) continue;
+    const int f = faces[0], n = p.faceSize(f);
+    const int k = p.cornerOf(f, p.edgeVertices[e][0]);
+    const int end = p.faceVerts(f)[(k + 1) % n] == p.edgeVertices[e][1] ? p.edgeVertices[e][1]
+                                                                          : p.edgeVertices[e][0];
+    c.ringStart[firstEdgeChild + e] = child(p, f, p.cornerOf(f, end));
+  }
+}
+
 void addHalves(const Topology& p, int firstEdgeChild, int firstHalf, Topology& c) {
   for (int e = 0; e < p.edgeCount(); ++e) {
     c.edgeVertices[firstHalf + 2 * e] = {firstEdgeChild + e, p.edgeVertices[e][0]};
@@ -76,6 +119,14 @@ Topology splitToQuads(const Topology& p) {
     }
   }
   c.completeAdjacency();
+  for (int f = 0; f < F; ++f) {  // an inner edge lies between the children at its two sides
+    const int n = p.faceSize(f), base = p.faceOffsets[f];
+    for (int k = 0; k < n; ++k) {
+      c.edgeFaces[c.edgeFaceOffsets[base + k]] = base + k;
+      c.edgeFaces[c.edgeFaceOffsets[base + k] + 1] = base + (k + 1) % n;
+    }
+  }
+  orderLikeFar(p, firstHalf, quadChild, edgeChild0, faceChild0, c);
   inheritTags(p, firstHalf, c);
   return c;
 }
@@ -126,6 +177,13 @@ Topology splitTriangles(const Topology& p) {
     c.faceHole[t] = p.faceHole[f];
   }
   c.completeAdjacency();
+  for (int f = 0; f < F; ++f) {  // an inner edge lies between a corner child and the middle one
+    for (int k = 0; k < 3; ++k) {
+      c.edgeFaces[c.edgeFaceOffsets[3 * f + k]] = 4 * f + k;
+      c.edgeFaces[c.edgeFaceOffsets[3 * f + k] + 1] = 4 * f + 3;
+    }
+  }
+  orderLikeFar(p, firstHalf, triangleChild, edgeChild0, -1, c);
   inheritTags(p, firstHalf, c);
   return c;
 }

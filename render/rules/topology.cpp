@@ -4,6 +4,7 @@
 #include <unordered_map>
 
 #include "render/core/error.h"
+#include "render/rules/sharpness.h"
 
 namespace limn::render::rules {
 
@@ -85,6 +86,19 @@ void assignTags(const mesh::ControlMesh& m, const std::unordered_map<uint64_t, i
     auto it = edgeIndex.find(edgeKey(c.v0, c.v1));
     if (it != edgeIndex.end()) t.edgeSharpness[it->second] = c.sharpness;  // the last one wins
   }
+  t.faceHole.assign(t.faceCount(), 0);
+  for (int f : m.holes) t.faceHole[f] = 1;
+  if (m.boundary == mesh::BoundaryInterpolation::None) {
+    // As OpenSubdiv: with no boundary interpolation, the faces around a boundary vertex have
+    // no limit surface unless the client made all its boundary edges infinitely sharp. They
+    // stay in the mesh as holes: their points still shape their neighbours.
+    for (int e = 0; e < t.edgeCount(); ++e) {
+      if (!t.isBoundaryEdge(e) || isInfinite(t.edgeSharpness[e])) continue;
+      for (int v : t.edgeVertices[e]) {
+        for (int f : t.vertexFacesOf(v)) t.faceHole[f] = 1;
+      }
+    }
+  }
   for (int e = 0; e < t.edgeCount(); ++e) {
     if (t.isBoundaryEdge(e)) t.edgeSharpness[e] = kInfinitelySharp;
   }
@@ -94,18 +108,6 @@ void assignTags(const mesh::ControlMesh& m, const std::unordered_map<uint64_t, i
     for (int v = 0; v < t.vertexCount; ++v) {
       if (t.vertexFacesOf(v).size() == 1 && t.vertexEdgesOf(v).size() == 2) {
         t.vertexSharpness[v] = kInfinitelySharp;
-      }
-    }
-  }
-  t.faceHole.assign(t.faceCount(), 0);
-  for (int f : m.holes) t.faceHole[f] = 1;
-  if (m.boundary == mesh::BoundaryInterpolation::None) {
-    // As OpenSubdiv: with no boundary interpolation the faces at the boundary have no limit
-    // surface; they stay in the mesh (their points still shape their neighbours) as holes.
-    for (int e = 0; e < t.edgeCount(); ++e) {
-      if (!t.isBoundaryEdge(e)) continue;
-      for (int v : t.edgeVertices[e]) {
-        for (int f : t.vertexFacesOf(v)) t.faceHole[f] = 1;
       }
     }
   }
@@ -181,7 +183,8 @@ VertexRing orderedRing(const Topology& t, int v) {
     return t.faceEdgesOf(f)[(k + n - 1) % n];
   };
 
-  int start = faces[0], startCorner = t.cornerOf(start, v);
+  int start = t.ringStart.empty() || t.ringStart[v] < 0 ? faces[0] : t.ringStart[v];
+  int startCorner = t.cornerOf(start, v);
   for (int f : faces) {
     int k = t.cornerOf(f, v);
     if (t.isBoundaryEdge(leading(f, k))) {

@@ -10,8 +10,9 @@
 //
 // The tags follow OpenSubdiv's Far factory: boundary edges are infinitely sharp; with
 // "edge-and-corner" boundaries a vertex with one face and two edges is an infinitely sharp
-// corner; with "none" every face touching a boundary vertex becomes a hole. Only manifold,
-// consistently oriented meshes are accepted (fromMesh throws InputError otherwise).
+// corner; with "none" the faces around a boundary vertex become holes unless all its boundary
+// edges were tagged infinitely sharp. Only manifold, consistently oriented meshes are accepted
+// (fromMesh throws InputError otherwise).
 #pragma once
 
 #include <array>
@@ -52,6 +53,10 @@ struct Topology {
   std::vector<int> vertexEdgeOffsets, vertexEdges;
   std::vector<int> vertexFaceOffsets, vertexFaces;
 
+  // Per vertex, the face its counter-clockwise ring starts at, as OpenSubdiv orders it (see
+  // orderedRing); empty or -1: the vertex's lowest-numbered face. Only read at interior vertices.
+  std::vector<int> ringStart;
+
   // ---- Tags ----
   std::vector<float> edgeSharpness;    // boundary edges are kInfinitelySharp
   std::vector<float> vertexSharpness;  // corners
@@ -84,7 +89,8 @@ struct Topology {
   // Position of vertex v among the corners of face f.
   int cornerOf(int f, int v) const;
 
-  // Fills edgeFaces, vertexEdges and vertexFaces from faceVertices, faceEdges and edgeVertices.
+  // Fills edgeFaces (each edge's faces in face order), vertexEdges and vertexFaces from
+  // faceVertices, faceEdges and edgeVertices.
   void completeAdjacency();
 
   // The base level of a validated ControlMesh. Throws InputError(InvalidMesh) naming the edge
@@ -96,7 +102,8 @@ struct Topology {
 // faces' counter-clockwise winding faces). Face i lies between edges i and i+1; edge i is the
 // edge from the vertex to the next corner of face i. A boundary vertex starts at the face whose
 // leading edge is a boundary edge and has one more edge than faces; an interior vertex starts
-// at vertexFacesOf(v)[0] and has as many edges as faces.
+// at ringStart[v] (the lowest-numbered face at the base level, where OpenSubdiv starts too;
+// refined levels inherit OpenSubdiv's starts from their parents) and has as many edges as faces.
 struct VertexRing {
   std::vector<int> faces;
   std::vector<int> edges;

@@ -1,6 +1,7 @@
 // The approximations of the limit surface that limn draws.
 //   coarse:   the control cage itself, polygons fanned into triangles;
-//   uniform:  the cage refined `level` times (OpenSubdiv's uniform refinement);
+//   uniform:  the cage refined `level` times (OpenSubdiv's uniform refinement or limn's own
+//             rules), optionally pushed to the limit;
 //   adaptive: each face's limit surface tessellated with per-edge rates chosen from the
 //             projected edge length, shared edges sharing their rate and their vertices, so the
 //             mesh is watertight.
@@ -17,7 +18,24 @@ namespace limn::render::tessellate {
 
 TriangleMesh tessellateCoarse(const subdiv::LimitSurface& surface);
 
-// Throws InputError(LimitExceeded, "maxTriangles") if the result would exceed maxTriangles.
+// Which implementation of the subdivision rules refines a uniform mesh: OpenSubdiv's Far, or
+// limn's own (render/rules) by masks or, for Catmull-Clark, in factored form. All three give
+// the same vertices in the same order where their rules agree (docs/engine.md).
+enum class UniformEngine { OpenSubdiv, Masks, Factored };
+
+struct UniformOptions {
+  int level = 3;
+  UniformEngine engine = UniformEngine::OpenSubdiv;
+  // false: vertices stay where refinement put them (limitPositions holds their limit);
+  // true: every vertex is moved to its limit position. Normals are the limit normals either way.
+  bool pushToLimit = false;
+  size_t maxTriangles = 8'000'000;
+};
+
+// Throws InputError(LimitExceeded, "maxTriangles") if the result would exceed maxTriangles,
+// and InputError(InvalidMesh) when limn's own rules cannot take the mesh (non-manifold).
+TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, const UniformOptions& options);
+// OpenSubdiv, not pushed to the limit.
 TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
                                size_t maxTriangles);
 

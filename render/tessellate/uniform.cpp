@@ -1,5 +1,7 @@
-// Uniform refinement of the cage with OpenSubdiv's Far: positions interpolated level by level,
-// then every vertex of the last level gets its limit position and limit normal.
+// Uniform refinement of the cage, by OpenSubdiv's Far (positions interpolated level by level,
+// then PrimvarRefiner::Limit) or by limn's own rules (render/rules: masks or factored, then the
+// limit masks). Both give every vertex of the last level its refined position, its limit
+// position and its limit normal; the mesh is assembled from those the same way.
 #include <cmath>
 #include <set>
 #include <string>
@@ -8,6 +10,8 @@
 #include <opensubdiv/far/topologyRefiner.h>
 
 #include "render/core/error.h"
+#include "render/rules/limit.h"
+#include "render/rules/refine.h"
 #include "render/tessellate/tessellate.h"
 
 namespace limn::render::tessellate {
@@ -28,6 +32,13 @@ struct Point {
   Vec3 vec() const { return {x, y, z}; }
 };
 
+// The last level of a refinement, whoever made it.
+struct Refined {
+  std::vector<Vec3> points, limit, normals;  // normals: any length, or zero where unknown
+  std::vector<int> faceOffsets{0}, faceVertices;
+  std::vector<uint8_t> hole;
+};
+
 // Triangles the refined mesh will have: Loop splits every triangle into 4 per level;
 // Catmull-Clark and bilinear split an n-gon into n quads at the first level, each quad into 4
 // after that, and every quad is drawn as 2 triangles.
@@ -41,19 +52,7 @@ size_t predictedTriangles(const mesh::ControlMesh& cage, int level) {
   return static_cast<size_t>(count * std::pow(4.0, level));
 }
 
-}  // namespace
-
-TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
-                               size_t maxTriangles) {
-  size_t predicted = predictedTriangles(surface.mesh(), level);
-  if (predicted > maxTriangles) {
-    throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
-                     "uniform level " + std::to_string(level) + " would make " +
-                         std::to_string(predicted) + " triangles: exceeds limit maxTriangles " +
-                         std::to_string(maxTriangles));
-  }
-  if (level == 0) return tessellateCoarse(surface);
-
+Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
   std::unique_ptr<Far::TopologyRefiner> refiner = surface.createRefiner();
   Far::TopologyRefiner::UniformOptions options(level);
   options.fullTopologyInLastLevel = true;
@@ -77,30 +76,63 @@ TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
   std::vector<Point> limit(vertexCount), du(vertexCount), dv(vertexCount);
   primvar.Limit(src, limit, du, dv);
 
+  Refined out;
+  for (int v = 0; v < vertexCount; ++v) {
+    out.points.push_back(src[v].vec());
+    out.limit.push_back(limit[v].vec());
+    out.normals.push_back(cross(du[v].vec(), dv[v].vec()));
+  }
+  for (int f = 0; f < last.GetNumFaces(); ++f) {
+    Far::ConstIndexArray fv = last.GetFaceVertices(f);
+    out.faceVertices.insert(out.faceVertices.end(), fv.begin(), fv.end());
+    out.faceOffsets.push_back(static_cast<int>(out.faceVertices.size()));
+    out.hole.push_back(last.IsFaceHole(f));
+  }
+  return out;
+}
+
+Refined refineWithRules(const mesh::ControlMesh& cage, int level, rules::Method method) {
+  rules::Level refined = rules::refineUniform(cage, level, method);
+  rules::Limit limit = rules::limitOf(refined);
+  Refined out;
+  out.points = std::move(refined.points);
+  out.limit = std::move(limit.positions);
+  out.normals = std::move(limit.normals);
+  out.faceOffsets = std::move(refined.topology.faceOffsets);
+  out.faceVertices = std::move(refined.topology.faceVertices);
+  out.hole = std::move(refined.topology.faceHole);
+  return out;
+}
+
+TriangleMesh assemble(const Refined& r, bool pushToLimit) {
+  const int vertexCount = static_cast<int>(r.points.size());
+  const std::vector<Vec3>& drawn = pushToLimit ? r.limit : r.points;
   TriangleMesh out;
   out.positions.reserve(vertexCount);
   for (int v = 0; v < vertexCount; ++v) {
-    out.positions.emplace_back(src[v].vec());
-    out.limitPositions.emplace_back(limit[v].vec());
+    out.positions.emplace_back(drawn[v]);
+    out.limitPositions.emplace_back(r.limit[v]);
   }
 
   // Faces, and per-vertex face normals to orient the limit normals consistently.
   std::vector<Vec3> faceNormalSum(vertexCount, Vec3{0, 0, 0});
   std::set<std::pair<int, int>> seen;
-  for (int f = 0; f < last.GetNumFaces(); ++f) {
-    if (last.IsFaceHole(f)) continue;
-    Far::ConstIndexArray fv = last.GetFaceVertices(f);
-    for (int k = 1; k + 1 < fv.size(); ++k) {
+  const int faceCount = static_cast<int>(r.faceOffsets.size()) - 1;
+  for (int f = 0; f < faceCount; ++f) {
+    if (r.hole[f]) continue;
+    const int* fv = r.faceVertices.data() + r.faceOffsets[f];
+    const int n = r.faceOffsets[f + 1] - r.faceOffsets[f];
+    for (int k = 1; k + 1 < n; ++k) {
       out.indices.insert(out.indices.end(), {static_cast<uint32_t>(fv[0]),
                                              static_cast<uint32_t>(fv[k]),
                                              static_cast<uint32_t>(fv[k + 1])});
-      Vec3 n = cross(src[fv[k]].vec() - src[fv[0]].vec(), src[fv[k + 1]].vec() - src[fv[0]].vec());
-      faceNormalSum[fv[0]] += n;
-      faceNormalSum[fv[k]] += n;
-      faceNormalSum[fv[k + 1]] += n;
+      Vec3 normal = cross(drawn[fv[k]] - drawn[fv[0]], drawn[fv[k + 1]] - drawn[fv[0]]);
+      faceNormalSum[fv[0]] += normal;
+      faceNormalSum[fv[k]] += normal;
+      faceNormalSum[fv[k + 1]] += normal;
     }
-    for (int k = 0; k < fv.size(); ++k) {
-      int a = fv[k], b = fv[(k + 1) % fv.size()];
+    for (int k = 0; k < n; ++k) {
+      int a = fv[k], b = fv[(k + 1) % n];
       if (seen.insert({std::min(a, b), std::max(a, b)}).second) {
         out.lines.insert(out.lines.end(), {static_cast<uint32_t>(a), static_cast<uint32_t>(b)});
       }
@@ -108,13 +140,46 @@ TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
   }
   out.normals.resize(vertexCount);
   for (int v = 0; v < vertexCount; ++v) {
-    Vec3 n = normalize(cross(du[v].vec(), dv[v].vec()));
+    Vec3 n = normalize(r.normals[v]);
     Vec3 around = faceNormalSum[v];
     if (length(n) == 0) n = normalize(around);  // degenerate tangents: use the faces' normal
     if (dot(n, around) < 0) n = -n;
     out.normals[v] = Vec3f(n);
   }
   return out;
+}
+
+}  // namespace
+
+TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, const UniformOptions& o) {
+  size_t predicted = predictedTriangles(surface.mesh(), o.level);
+  if (predicted > o.maxTriangles) {
+    throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
+                     "uniform level " + std::to_string(o.level) + " would make " +
+                         std::to_string(predicted) + " triangles: exceeds limit maxTriangles " +
+                         std::to_string(o.maxTriangles));
+  }
+  if (o.engine != UniformEngine::OpenSubdiv) {
+    rules::Method method =
+        o.engine == UniformEngine::Masks ? rules::Method::Masks : rules::Method::Factored;
+    std::string whyNot = rules::unsupportedReason(surface.mesh(), method);
+    if (!whyNot.empty()) throw InputError(InputError::Kind::InvalidParameter, "engine", whyNot);
+    return assemble(refineWithRules(surface.mesh(), o.level, method), o.pushToLimit);
+  }
+  if (o.level == 0) {
+    TriangleMesh coarse = tessellateCoarse(surface);
+    if (o.pushToLimit) coarse.positions = coarse.limitPositions;
+    return coarse;
+  }
+  return assemble(refineWithFar(surface, o.level), o.pushToLimit);
+}
+
+TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
+                               size_t maxTriangles) {
+  UniformOptions options;
+  options.level = level;
+  options.maxTriangles = maxTriangles;
+  return tessellateUniform(surface, options);
 }
 
 }  // namespace limn::render::tessellate

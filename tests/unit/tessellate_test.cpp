@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <tuple>
 
@@ -82,6 +83,68 @@ TEST(Uniform, RefusesMoreTrianglesThanTheLimit) {
 TEST(Uniform, LoopMeshesStayTriangles) {
   subdiv::LimitSurface surface(testing::icosahedron());
   EXPECT_EQ(tessellateUniform(surface, 2, 1'000'000).triangleCount(), 20u * 16u);
+}
+
+// limn's own rules draw the same mesh as OpenSubdiv: same vertices in the same order, same
+// limit positions, normals within float precision (render/rules is tested shape by shape in
+// rules_test.cpp; this checks the assembly).
+TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
+  for (const mesh::ControlMesh& cage : {testing::cube(), testing::torus(), testing::icosahedron()}) {
+    subdiv::LimitSurface surface(cage);
+    UniformOptions options;
+    options.level = 2;
+    TriangleMesh far = tessellateUniform(surface, options);
+    for (UniformEngine engine : {UniformEngine::Masks, UniformEngine::Factored}) {
+      if (engine == UniformEngine::Factored && (cage.scheme == mesh::Scheme::Loop ||
+                                                !cage.creases.empty())) {
+        continue;
+      }
+      options.engine = engine;
+      TriangleMesh own = tessellateUniform(surface, options);
+      ASSERT_EQ(own.indices, far.indices);
+      ASSERT_EQ(own.lines, far.lines);
+      ASSERT_EQ(own.positions.size(), far.positions.size());
+      for (size_t v = 0; v < far.positions.size(); ++v) {
+        EXPECT_LT(length(own.positions[v].toDouble() - far.positions[v].toDouble()), 1e-6);
+        EXPECT_LT(length(own.limitPositions[v].toDouble() - far.limitPositions[v].toDouble()), 1e-6);
+        const Vec3 a = own.normals[v].toDouble(), b = far.normals[v].toDouble();
+        EXPECT_LT(std::atan2(length(cross(a, b)), dot(a, b)) * 180 / M_PI, 0.01) << "vertex " << v;
+      }
+    }
+  }
+}
+
+TEST(Uniform, PushToLimitMovesEveryVertexToItsLimit) {
+  subdiv::LimitSurface surface(testing::torus());
+  for (UniformEngine engine : {UniformEngine::OpenSubdiv, UniformEngine::Masks}) {
+    for (int level : {0, 2}) {
+      UniformOptions options;
+      options.level = level;
+      options.engine = engine;
+      TriangleMesh refined = tessellateUniform(surface, options);
+      options.pushToLimit = true;
+      TriangleMesh pushed = tessellateUniform(surface, options);
+      double before = 0;
+      for (size_t v = 0; v < pushed.positions.size(); ++v) {
+        EXPECT_EQ(length(pushed.positions[v].toDouble() - pushed.limitPositions[v].toDouble()), 0.0);
+        before = std::max(before, length(refined.positions[v].toDouble() -
+                                         refined.limitPositions[v].toDouble()));
+      }
+      EXPECT_GT(before, 1e-3) << "the refined vertices were already on the limit";
+    }
+  }
+}
+
+TEST(Uniform, FactoredRefusesLoop) {
+  subdiv::LimitSurface surface(testing::icosahedron());
+  UniformOptions options;
+  options.engine = UniformEngine::Factored;
+  try {
+    tessellateUniform(surface, options);
+    FAIL() << "factored refined a Loop mesh";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), InputError::Kind::InvalidParameter);
+  }
 }
 
 class AdaptiveWatertight : public ::testing::TestWithParam<int> {};
