@@ -26,8 +26,14 @@ namespace limn::render::pipeline {
 
 enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette };
 
+// Who refines for method "uniform": OpenSubdiv's Far, or limn's own rules (render/rules) by
+// masks or, for Catmull-Clark, in factored form.
+enum class Engine { OpenSubdiv, Masks, Factored };
+
 struct MethodParams {
   int level = 3;                // uniform
+  Engine engine = Engine::OpenSubdiv;  // uniform
+  bool pushToLimit = false;     // uniform: move every refined vertex to its limit position
   double dicingRate = 1.0;      // adaptive: target edge length in pixels
   int metricSupersample = 4;    // S for the silhouette metrics
   // silhouette
@@ -40,6 +46,7 @@ struct MethodParams {
 struct Outputs {
   bool color = true, mask = false, depth = false, normal = false, wireframe = false;
   bool contours = false;  // silhouette: contour curves, corrected faces, searched edges
+  bool cage = false;      // the control mesh's edges drawn over the colour image
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.

@@ -6,10 +6,12 @@
 #include "render/pipeline/render_job.h"
 #include "render/pipeline/silhouette_build.h"
 #include "render/raster/rasterizer.h"
+#include "render/rules/refine.h"
 #include "render/normalmap/mapped_cage.h"
 #include "render/normalmap/normal_atlas.h"
 #include "render/silhouette/contour_overlay.h"
 #include "render/subdiv/limit_surface.h"
+#include "render/tessellate/cage_overlay.h"
 #include "render/tessellate/tessellate.h"
 
 namespace limn::render::pipeline {
@@ -39,6 +41,14 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
       job.method != Method::Coarse) {
     badParameter("shading", "\"normal-map\" is available with methods \"silhouette\" and "
                             "\"coarse\" (the others draw limit normals per vertex)");
+  }
+  if (job.method == Method::Uniform && p.engine != Engine::OpenSubdiv) {
+    std::string whyNot = rules::unsupportedReason(
+        job.mesh, p.engine == Engine::Masks ? rules::Method::Masks : rules::Method::Factored);
+    if (!whyNot.empty()) {
+      const char* name = p.engine == Engine::Masks ? "\"masks\"" : "\"factored\"";
+      badParameter("params.engine", std::string(name) + " cannot refine this mesh: " + whyNot);
+    }
   }
   if (p.level < 0 || p.level > limits.maxLevel) {
     badParameter("params.level", "must be in 0.." + std::to_string(limits.maxLevel));
@@ -100,8 +110,16 @@ tessellate::TriangleMesh approximate(const RenderJob& job, const JobLimits& limi
         return normalmap::mappedCage(surface, makeAtlas(surface, camera));
       }
       return tessellate::tessellateCoarse(surface);
-    case Method::Uniform:
-      return tessellate::tessellateUniform(surface, job.params.level, limits.maxTriangles);
+    case Method::Uniform: {
+      tessellate::UniformOptions options;
+      options.level = job.params.level;
+      options.engine = job.params.engine == Engine::Masks      ? tessellate::UniformEngine::Masks
+                       : job.params.engine == Engine::Factored ? tessellate::UniformEngine::Factored
+                                                               : tessellate::UniformEngine::OpenSubdiv;
+      options.pushToLimit = job.params.pushToLimit;
+      options.maxTriangles = limits.maxTriangles;
+      return tessellate::tessellateUniform(surface, options);
+    }
     case Method::Adaptive: {
       tessellate::AdaptiveOptions options;
       options.dicingRate = job.params.dicingRate;
@@ -149,6 +167,7 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   keep(outputs.normal, pass::kNormal);
   if (!isReference) keep(outputs.wireframe, pass::kWireframe);
   if (!isReference) keep(outputs.contours, pass::kContours);
+  if (!isReference) keep(outputs.cage, pass::kCage);
   return selected;
 }
 
@@ -202,6 +221,9 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     }
   } else if (job.method != Method::Limit) {
     approx = approximate(job, limits, surface, camera, cancel);
+  }
+  if (approx && job.outputs.cage) {
+    overlays.push_back(tessellate::cageOverlay(job.mesh, pass::kCage));  // the client's cage
   }
   if (approx) {
     result.stats.triangles = approx->triangleCount();
