@@ -17,50 +17,21 @@ struct Tangents {
   Vec3 t1{0, 0, 0}, t2{0, 0, 0};
 };
 
+Vec3 unitCross(const Tangents& t) { return normalize(cross(t.t1, t.t2)); }
+
+// The weights of the interior tangents at valence n, computed once per valence.
+struct SmoothWeights {
+  std::vector<double> cosines, sines;  // cos(2 pi i / n), sin(2 pi i / n)
+  double faceScale = 0;                // Catmull-Clark: 1 / (4 lambda - 1)
+};
+
 // One side of a vertex: the ends of its edges E[0..m] and, for Catmull-Clark, the corners
 // diagonal to the vertex in its faces F[0..m-1] (face i between edges i and i+1), in
-// counter-clockwise order. A whole interior ring has as many edges as faces (E[m] == E[0] is
-// not repeated).
+// counter-clockwise order. Used for the two sides of a crease and the whole of a boundary.
 struct Side {
   Vec3 v;
   std::vector<Vec3> E, F;
 };
-
-Vec3 weighted(const std::vector<Vec3>& points, const std::vector<double>& w) {
-  Vec3 sum{0, 0, 0};
-  for (size_t i = 0; i < w.size(); ++i) sum += w[i] * points[i];
-  return sum;
-}
-
-// Interior (smooth or dart) vertex: eigenvector tangents.
-Tangents smoothTangents(mesh::Scheme scheme, const Side& s) {
-  const int n = static_cast<int>(s.E.size());
-  const double theta = 2.0 * kPi / n;
-  std::vector<double> c(n), sn(n);
-  for (int i = 0; i < n; ++i) {
-    c[i] = std::cos(i * theta);
-    sn[i] = std::sin(i * theta);
-  }
-  Tangents t;
-  if (scheme == mesh::Scheme::Loop) {
-    t.t1 = weighted(s.E, c);
-    t.t2 = weighted(s.E, sn);
-    return t;
-  }
-  // Catmull-Clark: edge weights 4 cos(i theta), face weights (cos(i theta) + cos((i+1) theta))
-  // / (4 lambda - 1), lambda the subdominant eigenvalue; the second tangent is the first
-  // rotated by one edge.
-  const double lambda =
-      5.0 / 16.0 +
-      (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
-  const double faceScale = 1.0 / (4.0 * lambda - 1.0);
-  for (int i = 0; i < n; ++i) {
-    const int prev = (i + n - 1) % n;
-    t.t1 += 4.0 * c[i] * s.E[i] + faceScale * (c[i] + c[(i + 1) % n]) * s.F[i];
-    t.t2 += 4.0 * c[prev] * s.E[i] + faceScale * (c[prev] + c[i]) * s.F[i];
-  }
-  return t;
-}
 
 // One side of a crease (or the whole of a boundary vertex): E[0] and E[m] are the crease.
 Tangents creaseTangents(mesh::Scheme scheme, const Side& s) {
@@ -106,95 +77,144 @@ Tangents creaseTangents(mesh::Scheme scheme, const Side& s) {
   return t;
 }
 
-Vec3 unitCross(const Tangents& t) { return normalize(cross(t.t1, t.t2)); }
+// The limit of every vertex of one level, one vertex at a time, with scratch buffers and
+// per-valence weights kept between vertices.
+class LimitMasks {
+ public:
+  LimitMasks(const Topology& t, const std::vector<Vec3>& points)
+      : t_(t), P_(points), scheme_(t.options.scheme) {}
 
-struct VertexLimit {
-  Vec3 position;
-  Tangents tangents;       // the vertex's own: see limit.h
-  VertexRing ring;
-  std::vector<Vec3> face;  // normal per face of the ring
-};
-
-VertexLimit limitAt(const Topology& t, const std::vector<Vec3>& P, int v) {
-  const mesh::Scheme scheme = t.options.scheme;
-  const Rule rule = currentRule(t, v);
-  VertexLimit out;
-  out.ring = orderedRing(t, v);
-  const VertexRing& ring = out.ring;
-  const int faces = static_cast<int>(ring.faces.size());
-  const int edges = static_cast<int>(ring.edges.size());
-  out.position = P[v];
-  out.face.assign(faces, Vec3{0, 0, 0});
-  if (faces == 0) return out;
-
-  std::vector<Vec3> E(edges), F(faces);
-  for (int i = 0; i < edges; ++i) E[i] = P[t.otherVertex(ring.edges[i], v)];
-  if (scheme == mesh::Scheme::CatmullClark) {
+  void evaluate(int v, Limit& out) {
+    orderedRing(t_, v, ring_);
+    const int faces = static_cast<int>(ring_.faces.size());
+    const int edges = static_cast<int>(ring_.edges.size());
+    Tangents tangents;
+    Vec3 position = P_[v];
+    faceNormals_.assign(faces, Vec3{0, 0, 0});
+    if (faces > 0) {
+      E_.resize(edges);
+      for (int i = 0; i < edges; ++i) E_[i] = P_[t_.otherVertex(ring_.edges[i], v)];
+      F_.resize(faces);
+      if (scheme_ == mesh::Scheme::CatmullClark) {
+        for (int i = 0; i < faces; ++i) {
+          std::span<const int> fv = t_.faceVerts(ring_.faces[i]);
+          F_[i] = P_[fv[(ring_.corners[i] + 2) % fv.size()]];
+        }
+      }
+      switch (currentRule(t_, v)) {
+        case Rule::Corner: tangents = cornerSides(v); break;
+        case Rule::Crease: tangents = creaseSides(v, position); break;
+        case Rule::Smooth:
+        case Rule::Dart: tangents = smooth(v, position); break;
+      }
+    }
+    out.positions[v] = position;
+    out.tangent1[v] = tangents.t1;
+    out.tangent2[v] = tangents.t2;
+    out.normals[v] = unitCross(tangents);
     for (int i = 0; i < faces; ++i) {
-      std::span<const int> fv = t.faceVerts(ring.faces[i]);
-      F[i] = P[fv[(ring.corners[i] + 2) % fv.size()]];
+      out.cornerNormals[t_.faceOffsets[ring_.faces[i]] + ring_.corners[i]] = faceNormals_[i];
     }
   }
-  auto edgeEnd = [&](int i) { return E[i % edges]; };  // E[faces] wraps on interior rings
+
+ private:
+  // E[i] on a whole ring, where E[faces] is E[0] again.
+  const Vec3& edgeEnd(int i) const { return E_[i % E_.size()]; }
 
   // Each face's own corner plane: the corner rule's tangents (and valence-2 Catmull-Clark).
-  auto cornerSides = [&] {
+  Tangents cornerSides(int v) {
+    const int faces = static_cast<int>(ring_.faces.size());
     for (int i = 0; i < faces; ++i) {
-      out.face[i] = unitCross({edgeEnd(i) - P[v], edgeEnd(i + 1) - P[v]});
+      faceNormals_[i] = unitCross({edgeEnd(i) - P_[v], edgeEnd(i + 1) - P_[v]});
     }
-    out.tangents = {edgeEnd(0) - P[v], edgeEnd(1) - P[v]};
-    if (scheme == mesh::Scheme::Loop) out.tangents = {3.0 * out.tangents.t1, 3.0 * out.tangents.t2};
-  };
-
-  if (rule == Rule::Corner) {
-    cornerSides();
-    return out;
+    const double scale = scheme_ == mesh::Scheme::Loop ? 3.0 : 1.0;  // OpenSubdiv's scales
+    return {scale * (edgeEnd(0) - P_[v]), scale * (edgeEnd(1) - P_[v])};
   }
-  if (rule == Rule::Crease) {
-    std::vector<int> sharp;
-    for (int i = 0; i < edges; ++i) {
-      if (isSharp(t.edgeSharpness[ring.edges[i]])) sharp.push_back(i);
+
+  Tangents creaseSides(int v, Vec3& position) {
+    const int faces = static_cast<int>(ring_.faces.size());
+    int sharp[2] = {-1, -1};
+    for (int i = 0, found = 0; i < static_cast<int>(ring_.edges.size()) && found < 2; ++i) {
+      if (isSharp(t_.edgeSharpness[ring_.edges[i]])) sharp[found++] = i;
     }
-    const Vec3 a = E[sharp[0]], b = E[sharp[1]];
-    out.position = (4.0 * P[v] + a + b) / 6.0;
+    position = (4.0 * P_[v] + E_[sharp[0]] + E_[sharp[1]]) / 6.0;
     // The sides: from each sharp edge counter-clockwise to the next (a boundary vertex has one).
-    const int sides = ring.boundary ? 1 : 2;
-    for (int side = 0; side < sides; ++side) {
-      const int first = sharp[side], last = side == 0 ? sharp[1] : sharp[0] + faces;
-      Side s{P[v], {}, {}};
-      for (int i = first; i <= last; ++i) s.E.push_back(edgeEnd(i));
-      for (int i = first; i < last; ++i) s.F.push_back(F[i % faces]);
-      const Tangents tangents = creaseTangents(scheme, s);
+    Tangents own;
+    const int sides = ring_.boundary ? 1 : 2;
+    for (int s = 0; s < sides; ++s) {
+      const int first = sharp[s], last = s == 0 ? sharp[1] : sharp[0] + faces;
+      side_.v = P_[v];
+      side_.E.clear();
+      side_.F.clear();
+      for (int i = first; i <= last; ++i) side_.E.push_back(edgeEnd(i));
+      for (int i = first; i < last; ++i) side_.F.push_back(F_[i % faces]);
+      const Tangents tangents = creaseTangents(scheme_, side_);
       const Vec3 normal = unitCross(tangents);
-      for (int i = first; i < last; ++i) out.face[i % faces] = normal;
+      for (int i = first; i < last; ++i) faceNormals_[i % faces] = normal;
       // OpenSubdiv's convention: the side counter-clockwise from the first sharp edge.
-      if (side == 0) out.tangents = tangents;
+      if (s == 0) own = tangents;
     }
-    return out;
+    return own;
   }
 
   // Smooth and dart: the interior eigenvectors.
-  const int n = faces;
-  if (scheme == mesh::Scheme::Loop) {
-    const double w = n == 6 ? 1.0 / 12.0 : loopLimitWeight(n);
-    Vec3 ring1{0, 0, 0};
-    for (const Vec3& e : E) ring1 += e;
-    out.position = (1.0 - n * w) * P[v] + w * ring1;
-  } else if (n == 2) {
-    cornerSides();  // OpenSubdiv's choice at an interior vertex of valence 2: the vertex itself
-    return out;
-  } else {
+  Tangents smooth(int v, Vec3& position) {
+    const int n = static_cast<int>(ring_.faces.size());
     Vec3 edgeSum{0, 0, 0}, faceSum{0, 0, 0};
-    for (const Vec3& e : E) edgeSum += e;
-    for (const Vec3& f : F) faceSum += f;
-    out.position = catmullClarkLimitVertexWeight(n) * P[v] +
-                   catmullClarkLimitEdgeWeight(n) * edgeSum +
-                   catmullClarkLimitFaceWeight(n) * faceSum;
+    for (int i = 0; i < n; ++i) edgeSum += E_[i];
+    Tangents t;
+    const SmoothWeights& w = weights(n);
+    if (scheme_ == mesh::Scheme::Loop) {
+      const double chi = n == 6 ? 1.0 / 12.0 : loopLimitWeight(n);
+      position = (1.0 - n * chi) * P_[v] + chi * edgeSum;
+      for (int i = 0; i < n; ++i) {
+        t.t1 += w.cosines[i] * E_[i];
+        t.t2 += w.sines[i] * E_[i];
+      }
+    } else {
+      if (n == 2) return cornerSides(v);  // OpenSubdiv's choice at an interior valence 2
+      for (int i = 0; i < n; ++i) faceSum += F_[i];
+      position = catmullClarkLimitVertexWeight(n) * P_[v] +
+                 catmullClarkLimitEdgeWeight(n) * edgeSum + catmullClarkLimitFaceWeight(n) * faceSum;
+      // Edge weights 4 cos(i theta), face weights (cos(i theta) + cos((i+1) theta)) /
+      // (4 lambda - 1), lambda the subdominant eigenvalue; the second tangent is the first
+      // rotated by one edge.
+      const std::vector<double>& c = w.cosines;
+      for (int i = 0; i < n; ++i) {
+        const int prev = (i + n - 1) % n, next = (i + 1) % n;
+        t.t1 += 4.0 * c[i] * E_[i] + w.faceScale * (c[i] + c[next]) * F_[i];
+        t.t2 += 4.0 * c[prev] * E_[i] + w.faceScale * (c[prev] + c[i]) * F_[i];
+      }
+    }
+    faceNormals_.assign(n, unitCross(t));
+    return t;
   }
-  out.tangents = smoothTangents(scheme, {P[v], E, F});
-  out.face.assign(faces, unitCross(out.tangents));
-  return out;
-}
+
+  const SmoothWeights& weights(int n) {
+    if (static_cast<int>(weights_.size()) <= n) weights_.resize(n + 1);
+    SmoothWeights& w = weights_[n];
+    if (w.cosines.empty()) {
+      const double theta = 2.0 * kPi / n;
+      for (int i = 0; i < n; ++i) {
+        w.cosines.push_back(std::cos(i * theta));
+        w.sines.push_back(std::sin(i * theta));
+      }
+      const double lambda =
+          5.0 / 16.0 +
+          (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
+      w.faceScale = 1.0 / (4.0 * lambda - 1.0);
+    }
+    return w;
+  }
+
+  const Topology& t_;
+  const std::vector<Vec3>& P_;
+  const mesh::Scheme scheme_;
+  VertexRing ring_;
+  std::vector<Vec3> E_, F_, faceNormals_;
+  Side side_;
+  std::vector<SmoothWeights> weights_;
+};
 
 bool hasNonQuad(const Topology& t) {
   for (int f = 0; f < t.faceCount(); ++f) {
@@ -234,17 +254,9 @@ Limit limitOf(const Level& level) {
   out.tangent1.resize(t.vertexCount);
   out.tangent2.resize(t.vertexCount);
   out.normals.resize(t.vertexCount);
-  out.cornerNormals.resize(t.faceVertices.size());
-  for (int v = 0; v < t.vertexCount; ++v) {
-    VertexLimit limit = limitAt(t, level.points, v);
-    out.positions[v] = limit.position;
-    out.tangent1[v] = limit.tangents.t1;
-    out.tangent2[v] = limit.tangents.t2;
-    out.normals[v] = unitCross(limit.tangents);
-    for (size_t i = 0; i < limit.ring.faces.size(); ++i) {
-      out.cornerNormals[t.faceOffsets[limit.ring.faces[i]] + limit.ring.corners[i]] = limit.face[i];
-    }
-  }
+  out.cornerNormals.assign(t.faceVertices.size(), Vec3{0, 0, 0});
+  LimitMasks masks(t, level.points);
+  for (int v = 0; v < t.vertexCount; ++v) masks.evaluate(v, out);
   return out;
 }
 

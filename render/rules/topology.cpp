@@ -175,8 +175,17 @@ Topology Topology::fromMesh(const mesh::ControlMesh& m) {
 
 VertexRing orderedRing(const Topology& t, int v) {
   VertexRing ring;
+  orderedRing(t, v, ring);
+  return ring;
+}
+
+void orderedRing(const Topology& t, int v, VertexRing& ring) {
+  ring.faces.clear();
+  ring.edges.clear();
+  ring.corners.clear();
+  ring.boundary = false;
   std::span<const int> faces = t.vertexFacesOf(v);
-  if (faces.empty()) return ring;
+  if (faces.empty()) return;
   auto leading = [&](int f, int k) { return t.faceEdgesOf(f)[k]; };
   auto trailing = [&](int f, int k) {
     int n = t.faceSize(f);
@@ -211,7 +220,6 @@ VertexRing orderedRing(const Topology& t, int v) {
     f = next;
     k = t.cornerOf(f, v);
   }
-  return ring;
 }
 
 }  // namespace limn::render::rules

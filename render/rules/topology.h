@@ -111,5 +111,7 @@ struct VertexRing {
   bool boundary = false;
 };
 VertexRing orderedRing(const Topology& topology, int v);
+// The same into `ring`, reusing its storage.
+void orderedRing(const Topology& topology, int v, VertexRing& ring);
 
 }  // namespace limn::render::rules
