@@ -51,13 +51,17 @@ ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const C
   out.edgeRates.assign(base.GetNumEdges(), 0);
   out.interiorRates.assign(surface.faceCount(), 0);
 
-  // The contour faces and the ring of faces sharing a vertex with them.
-  std::vector<bool> near(surface.faceCount(), false);
-  for (int f = 0; f < surface.faceCount(); ++f) {
-    if (!contourFace[f]) continue;
-    for (int v : base.GetFaceVertices(f)) {
-      for (int g : base.GetVertexFaces(v)) near[g] = true;
+  // The contour faces and `options.rings` rings of faces around them (sharing a vertex).
+  std::vector<bool> near = contourFace;
+  for (int ring = 0; ring < options.rings; ++ring) {
+    std::vector<bool> grown = near;
+    for (int f = 0; f < surface.faceCount(); ++f) {
+      if (!near[f]) continue;
+      for (int v : base.GetFaceVertices(f)) {
+        for (int g : base.GetVertexFaces(v)) grown[g] = true;
+      }
     }
+    near.swap(grown);
   }
   std::vector<bool> candidate(base.GetNumEdges(), false);
   for (int f = 0; f < surface.faceCount(); ++f) {

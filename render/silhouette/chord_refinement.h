@@ -1,9 +1,9 @@
 // Concave contours (part of step 4 of the silhouette method). The coarse faces are flat
 // triangles through points of the limit surface; where the surface is concave along an edge,
 // the chord lies OUTSIDE it, and next to the contour such a chord either pokes past the exact
-// outline (into a torus's hole, say) or hides part of it. The correction is propagated one
-// ring out from the contour faces: every edge of a contour face or of a face sharing a vertex
-// with one whose chord lies outside the surface by more than `tolerancePx` (projected) gets
+// outline (into a torus's hole, say) or hides part of it. The correction is propagated two
+// rings out from the contour faces: every edge of a contour face or of a face near one (see
+// ChordOptions::rings) whose chord lies outside the surface by more than `tolerancePx` (projected) gets
 // uniform points along its limit curve, enough to bring the chord's sag under the tolerance
 // (sag falls with the square of the segment count); such ring faces whose centre lies outside
 // the surface likewise get interior points. Chords inside the surface (convex regions) stay:
@@ -19,8 +19,12 @@
 namespace limn::render::silhouette {
 
 struct ChordOptions {
-  double tolerancePx = 0.25;
+  double tolerancePx = 0.1;
   int maxSegments = 32;  // per edge, and per side of a face's interior
+  // Rings of faces around the contour faces that are checked. Two, because where an outline
+  // passes close in front of another part (a torus's hole seen nearly closed) the faces two
+  // rings out still project next to it.
+  int rings = 2;
   int maxFaceSplits = 64;  // interior edge splits per contour face (face_refinement.h)
 };
 
