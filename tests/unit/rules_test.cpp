@@ -270,6 +270,7 @@ TEST_P(EveryShape, LimitPositionsAndNormalsMatchOpenSubdiv) {
   const double tolerance = 1e-6 * shape.mesh.bounds().diagonal();
 
   int direct = 0, bySide = 0, degenerate = 0;
+  double worstPosition = 0, worstNormalDeg = 0;
   for (int l = 1; l <= kMaxLevel; ++l) {
     *level = refine(*level, Method::Masks);
     const Limit mine = limitOf(*level);
@@ -277,8 +278,9 @@ TEST_P(EveryShape, LimitPositionsAndNormalsMatchOpenSubdiv) {
     const Topology& t = level->topology;
     ASSERT_EQ(mine.positions.size(), far.positions.size());
     for (int v = 0; v < t.vertexCount; ++v) {
-      EXPECT_LE(length(mine.positions[v] - far.positions[v].vec()), tolerance)
-          << shape.name << " level " << l << " vertex " << v;
+      const double gap = length(mine.positions[v] - far.positions[v].vec());
+      worstPosition = std::max(worstPosition, gap);
+      EXPECT_LE(gap, tolerance) << shape.name << " level " << l << " vertex " << v;
       Vec3 farNormal = cross(far.tangent1[v].vec(), far.tangent2[v].vec());
       if (length(farNormal) <= 1e-12 * length(far.tangent1[v].vec()) * length(far.tangent2[v].vec())) {
         ++degenerate;  // OpenSubdiv has no normal here (e.g. a corner between collinear edges)
@@ -286,6 +288,7 @@ TEST_P(EveryShape, LimitPositionsAndNormalsMatchOpenSubdiv) {
       }
       // Where the normal is not unique (interior creases, corners) limn's rings start where
       // OpenSubdiv's do, so the same side is chosen: the normals agree at every vertex.
+      worstNormalDeg = std::max(worstNormalDeg, angleDeg(mine.normals[v], farNormal));
       EXPECT_LE(angleDeg(mine.normals[v], farNormal), 0.01)
           << shape.name << " level " << l << " vertex " << v;
       // The vertex's normal is the one its first face sees.
@@ -299,6 +302,8 @@ TEST_P(EveryShape, LimitPositionsAndNormalsMatchOpenSubdiv) {
       ++(oneSide ? direct : bySide);
     }
   }
+  RecordProperty("maxRelPositionError", sci(worstPosition / shape.mesh.bounds().diagonal()));
+  RecordProperty("maxNormalErrorDeg", sci(worstNormalDeg));
   RecordProperty("normalsOneSided", direct);
   RecordProperty("normalsSeveralSides", bySide);
   RecordProperty("normalsDegenerate", degenerate);
