@@ -11,6 +11,7 @@
 #include "api/json_util.h"
 #include "api/obj_reader.h"
 #include "api/render_api.h"
+#include "api/request_parts.h"
 
 namespace limn::api {
 
@@ -265,20 +266,15 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
   if (!mesh) json::fail("mesh", "mesh is required");
   job.mesh = parseMesh(*mesh, limits, warnings);
 
-  // The view needs a direction: an eye on the target (given, or the mesh's centre) has none.
-  if (job.camera.eye) {
-    render::Vec3 target = job.camera.target.value_or(job.mesh.bounds().center());
-    if (render::length(*job.camera.eye - target) == 0) {
-      json::fail("camera.eye", "camera.eye is at the camera target: the view has no direction");
-    }
-  }
+  request::checkViewDirection(job.camera, job.mesh);
   return request;
 }
 
 }  // namespace
 
-RenderRequest parseRenderRequest(std::string_view body, const JobLimits& limits) {
-  rapidjson::Document document;
+namespace request {
+
+void parseJson(std::string_view body, rapidjson::Document& document) {
   // Iterative parsing: a deeply nested body must not exhaust the stack. UTF-8 is validated so
   // that text echoed back in messages is valid JSON.
   constexpr unsigned kFlags = rapidjson::kParseIterativeFlag |
@@ -293,6 +289,44 @@ RenderRequest parseRenderRequest(std::string_view body, const JobLimits& limits)
                        std::to_string(offset) + ")",
                    "{\"offset\": " + std::to_string(offset) + "}"};
   }
+}
+
+void warnUnknownFields(const Value& object, const std::string& prefix,
+                       std::initializer_list<const char*> known,
+                       std::vector<std::string>& warnings) {
+  api::warnUnknownFields(object, prefix, known, warnings);
+}
+
+render::CameraSpec parseCamera(const Value& camera, const JobLimits& limits,
+                               std::vector<std::string>& warnings) {
+  return api::parseCamera(camera, limits, warnings);
+}
+
+render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
+                                    std::vector<std::string>& warnings) {
+  return api::parseMesh(mesh, limits, warnings);
+}
+
+void parseSilhouetteParams(const Value& params, const JobLimits& limits,
+                           render::pipeline::MethodParams& out) {
+  api::parseSilhouetteParams(params, limits, out);
+}
+
+void checkViewDirection(const render::CameraSpec& camera, const render::mesh::ControlMesh& mesh) {
+  // The view needs a direction: an eye on the target (given, or the mesh's centre) has none.
+  if (camera.eye) {
+    render::Vec3 target = camera.target.value_or(mesh.bounds().center());
+    if (render::length(*camera.eye - target) == 0) {
+      json::fail("camera.eye", "camera.eye is at the camera target: the view has no direction");
+    }
+  }
+}
+
+}  // namespace request
+
+RenderRequest parseRenderRequest(std::string_view body, const JobLimits& limits) {
+  rapidjson::Document document;
+  request::parseJson(body, document);
   try {
     return parseDocument(document, limits);
   } catch (const render::InputError& error) {

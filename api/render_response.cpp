@@ -5,6 +5,7 @@
 #include "api/base64.h"
 #include "api/json_util.h"
 #include "api/render_api.h"
+#include "api/response_parts.h"
 
 namespace limn::api {
 
@@ -185,6 +186,17 @@ void writeCamera(Writer& w, const render::Camera& c) {
 }
 
 }  // namespace
+
+namespace response {
+
+void writeCamera(Writer& w, const render::Camera& camera) { api::writeCamera(w, camera); }
+
+void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& stats,
+                          bool presubdivided) {
+  api::writeSilhouetteStats(w, stats, presubdivided);
+}
+
+}  // namespace response
 
 std::string writeRenderResponse(const render::pipeline::RenderResult& result,
                                 const RenderRequest& request) {

@@ -41,7 +41,9 @@ Usage:
       worker per core. Port 0 picks a free port. Once it accepts connections it prints
         limn listening on http://HOST:PORT
       on stdout. SIGINT or SIGTERM shut it down cleanly (exit status 0).
-      Endpoints: POST /v1/render, GET /healthz, /readyz, /metrics, /openapi.json.
+      Endpoints: POST /v1/render (images and metrics), POST /v1/silhouette (the contour
+      curves of the limit surface as JSON polylines or SVG, pieces marked visible or hidden),
+      GET /healthz, /readyz, /metrics, /openapi.json.
 
   limn render REQUEST.json --out DIR [--config FILE]
       Runs one /v1/render request body through the engine without HTTP and writes

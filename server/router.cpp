@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "api/openapi.h"
+#include "api/silhouette_api.h"
 
 #ifndef LIMN_VERSION
 #define LIMN_VERSION "unknown"
@@ -23,7 +24,7 @@ struct Route {
 // Every (path, method) limn answers; a known path with another method is a 405 listing these.
 constexpr Route kRoutes[] = {
     {"/healthz", "GET"},      {"/readyz", "GET"},     {"/metrics", "GET"},
-    {"/openapi.json", "GET"}, {"/v1/render", "POST"},
+    {"/openapi.json", "GET"}, {"/v1/render", "POST"},  {"/v1/silhouette", "POST"},
 };
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
@@ -127,6 +128,9 @@ void Router::handle(Request request, Reply reply) {
   if (path == "/readyz") return reply(readyz());
   if (path == "/metrics") return reply(metrics());
   if (path == "/openapi.json") return reply(jsonAnswer(200, std::string(api::openApiDocument())));
+  if (path == "/v1/silhouette") {
+    return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
+  }
   render(std::move(request.body), std::move(reply));
 }
 
@@ -135,6 +139,17 @@ void Router::render(std::string body, Reply reply) {
       [body = std::move(body), limits = limits_](render::pipeline::RenderContext& context,
                                                  const render::CancelToken& cancel) {
         return api::handleRender(body, limits, context, cancel);
+      },
+      std::move(reply));
+}
+
+// Contours need no GL context, but share the render workers: one queue, one set of limits and
+// deadlines for everything that computes.
+void Router::silhouette(std::string body, std::string accept, Reply reply) {
+  pool_.submit(
+      [body = std::move(body), accept = std::move(accept), limits = limits_](
+          render::pipeline::RenderContext&, const render::CancelToken& cancel) {
+        return api::handleSilhouette(body, accept, limits, cancel);
       },
       std::move(reply));
 }

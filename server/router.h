@@ -9,6 +9,7 @@
 //   GET  /metrics       Prometheus text format
 //   GET  /openapi.json  the API description
 //   POST /v1/render     api::handleRender on a worker thread
+//   POST /v1/silhouette api::handleSilhouette on a worker thread (same queue, limits, timeout)
 #pragma once
 
 #include <chrono>
@@ -27,6 +28,7 @@ struct Request {
   std::string method;  // as sent: "GET", "POST", ...
   std::string target;  // path, possibly with "?query"
   std::string body;
+  std::string accept = {};  // the Accept header ("" when absent): /v1/silhouette may answer SVG
 };
 
 class Router {
@@ -50,6 +52,7 @@ class Router {
   api::Answer readyz() const;
   api::Answer metrics() const;
   void render(std::string body, Reply reply);
+  void silhouette(std::string body, std::string accept, Reply reply);
 
   render::pipeline::JobLimits limits_;
   WorkerPool& pool_;

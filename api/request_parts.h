@@ -1,0 +1,47 @@
+// The parts of a request body that several endpoints share (POST /v1/render and
+// POST /v1/silhouette): the JSON document itself, the mesh, the camera, the silhouette
+// method's params and the notes about unknown fields. Defined in render_request.cpp, where
+// /v1/render's reader uses them; every reader throws ApiError (400 invalid_json or
+// invalid_request naming the field, 413 too_large) or render::InputError for the mesh.
+#pragma once
+
+#include <rapidjson/document.h>
+
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/mesh/control_mesh.h"
+#include "render/pipeline/render_job.h"
+
+namespace limn::api::request {
+
+// Parses `body` into `document` (iterative, UTF-8 validated, full precision); a body that is
+// not JSON is a 400 invalid_json with the byte offset.
+void parseJson(std::string_view body, rapidjson::Document& document);
+
+// A warning for each member of `object` not in `known` ("ignored unknown field "camera.x"").
+void warnUnknownFields(const rapidjson::Value& object, const std::string& prefix,
+                       std::initializer_list<const char*> known,
+                       std::vector<std::string>& warnings);
+
+render::CameraSpec parseCamera(const rapidjson::Value& camera,
+                               const render::pipeline::JobLimits& limits,
+                               std::vector<std::string>& warnings);
+
+// The mesh in either form ("obj" or "json"), checked against limits.mesh.
+render::mesh::ControlMesh parseMesh(const rapidjson::Value& mesh,
+                                    const render::pipeline::JobLimits& limits,
+                                    std::vector<std::string>& warnings);
+
+// params.presubdivide, searchSteps, curveSamples and contour, where present, into `out`.
+void parseSilhouetteParams(const rapidjson::Value& params,
+                           const render::pipeline::JobLimits& limits,
+                           render::pipeline::MethodParams& out);
+
+// A 400 on camera.eye when the eye sits on the target (given, or the mesh's centre).
+void checkViewDirection(const render::CameraSpec& camera, const render::mesh::ControlMesh& mesh);
+
+}  // namespace limn::api::request
