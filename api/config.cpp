@@ -103,6 +103,8 @@ void readLimits(const Value& object, const std::string& source,
   r.integer("maxSupersample", limits.maxSupersample, 1);
   r.integer("maxLevel", limits.maxLevel, 0);
   r.number("minDicingRate", limits.minDicingRate, 0.0);
+  r.integer("maxSearchSteps", limits.maxSearchSteps, 0);
+  r.integer("maxCurveSamples", limits.maxCurveSamples, 0);
   r.size("maxTriangles", limits.maxTriangles, 1);
   r.finish();
 }
