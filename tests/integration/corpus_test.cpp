@@ -235,7 +235,7 @@ class EveryShape : public ::testing::TestWithParam<Shape> {};
 // Every method answers with an image (or, for a mesh OpenSubdiv refuses, a 422 naming why).
 TEST_P(EveryShape, EveryMethodAnswers) {
   const Shape& shape = GetParam();
-  for (const char* method : {"coarse", "uniform", "adaptive", "limit"}) {
+  for (const char* method : {"coarse", "uniform", "adaptive", "limit", "silhouette"}) {
     auto r = render(shape.obj, shape.scheme, method, 128, false, 2, R"(,"mask","depth","normal")");
     if (r->status == 422) {
       ASSERT_TRUE(r->body.HasMember("error")) << method;
@@ -288,6 +288,67 @@ TEST_P(EveryShape, ErrorsAgainstTheReference) {
               stats.HasMember("referenceCrossCheckPx")
                   ? std::to_string(stats["referenceCrossCheckPx"].GetDouble()).substr(0, 5).c_str()
                   : "n/a");
+}
+
+// "smooth", "semi-sharp" or "other": a closed mesh (every edge between exactly two faces, no
+// hole) without infinitely sharp tags is smooth, or semi-sharp if it has finite tags.
+std::string surfaceClass(const std::string& obj) {
+  std::map<std::pair<int, int>, int> edgeUses;
+  bool semi = false;
+  std::istringstream in(obj);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string kind;
+    words >> kind;
+    if (kind == "f") {
+      std::vector<int> face;
+      for (std::string v; words >> v;) face.push_back(std::stoi(v.substr(0, v.find('/'))));
+      for (size_t k = 0; k < face.size(); ++k) {
+        int a = face[k], b = face[(k + 1) % face.size()];
+        ++edgeUses[{std::min(a, b), std::max(a, b)}];
+      }
+    } else if (kind == "t") {
+      std::string tag, counts;
+      words >> tag >> counts;
+      if (tag == "hole") return "other";
+      if (tag == "crease" || tag == "corner") {
+        std::vector<double> values;
+        for (double x; words >> x;) values.push_back(x);
+        if (!values.empty() && values.back() >= 10) return "other";
+        semi = true;
+      }
+    }
+  }
+  for (const auto& [edge, uses] : edgeUses) {
+    if (uses != 2) return "other";
+  }
+  return semi ? "semi-sharp" : "smooth";
+}
+
+// The silhouette method's acceptance criteria at 1024^2: "exact" within 0.5 px of the exact
+// outline on closed smooth shapes and 1.0 px on closed semi-sharp ones, drawing fewer
+// triangles than uniform level 4 (the exact answers measure what it costs).
+TEST_P(EveryShape, SilhouetteAgainstTheReference) {
+  const Shape& shape = GetParam();
+  if (shape.scheme == "bilinear") GTEST_SKIP() << "bilinear surfaces are their own cage";
+  auto exact = render(shape.obj, shape.scheme, "silhouette", 1024, true);
+  if (exact->status == 422) GTEST_SKIP() << "OpenSubdiv does not accept this mesh";
+  ASSERT_EQ(exact->status, 200);
+  const rapidjson::Value& stats = exact->body["stats"];
+  ASSERT_TRUE(stats.HasMember("silhouette"));
+  const std::string kind = surfaceClass(shape.obj);
+  double px = hausdorff(*exact);
+  if (kind == "smooth") EXPECT_LE(px, 0.5) << shape.name;
+  if (kind == "semi-sharp") EXPECT_LE(px, 1.0) << shape.name;
+  EXPECT_EQ(stats["silhouette"]["trianglesDrawn"].GetUint64(), stats["triangles"].GetUint64());
+  if (kind != "other") {
+    auto level4 = render(shape.obj, shape.scheme, "uniform", 1024, false, 4);
+    ASSERT_EQ(level4->status, 200);
+    EXPECT_LT(stats["triangles"].GetUint64(), level4->body["stats"]["triangles"].GetUint64())
+        << shape.name;
+  }
+  std::printf("silhouette-result | %s | %s | %.3f | %llu |\n", shape.name.c_str(), kind.c_str(),
+              px, static_cast<unsigned long long>(stats["triangles"].GetUint64()));
 }
 
 std::string testName(const ::testing::TestParamInfo<Shape>& info) { return info.param.name; }

@@ -145,6 +145,43 @@ TEST_F(ServerTest, RenderOfACubeAnswersAPng) {
   EXPECT_EQ(doc["stats"]["controlFaces"].GetInt(), 6);
 }
 
+// The silhouette method through the server: exact outline on the cube, its counts, the
+// contour overlay as an extra image, and normal-map shading.
+TEST_F(ServerTest, SilhouetteMethodAnswersWithItsStatsAndOverlay) {
+  HttpResponse r = post(port(), "/v1/render",
+                        renderBody("silhouette", 256,
+                                   R"(, "shading": "normal-map", "reference": true,)"
+                                   R"( "outputs": ["color", "contours", "normal"])"));
+  ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+  auto doc = parseJson(r.body);
+  const auto& images = doc["images"];
+  ASSERT_TRUE(images.HasMember("contours"));
+  ASSERT_TRUE(images.HasMember("color"));
+  // The overlay draws lines over the colour: the two images differ.
+  EXPECT_NE(std::string(images["contours"]["data"].GetString()),
+            std::string(images["color"]["data"].GetString()));
+  const auto& silhouette = doc["stats"]["silhouette"];
+  EXPECT_TRUE(silhouette["presubdivided"].GetBool());  // 6 faces: "auto" refines
+  EXPECT_GT(silhouette["contourFaces"].GetUint64(), 0u);
+  EXPECT_GT(silhouette["contourPoints"].GetUint64(), 0u);
+  EXPECT_EQ(silhouette["trianglesDrawn"].GetUint64(), doc["stats"]["triangles"].GetUint64());
+  EXPECT_LE(doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 0.5);
+  // Normal-map shading reads limit normals per pixel: closer to the reference's normals than
+  // per-vertex interpolation, and far closer than flat facets. (Not equal: a pixel of the
+  // coarse mesh sees a chord, whose point lies off the surface point the reference sees.)
+  auto meanDeg = [&](const std::string& shading) {
+    HttpResponse answer = post(port(), "/v1/render",
+                               renderBody("silhouette", 256,
+                                          R"(, "shading": ")" + shading +
+                                              R"(", "reference": true, "outputs": ["normal"])"));
+    EXPECT_EQ(answer.status, 200);
+    return parseJson(answer.body)["metrics"]["normal"]["meanDeg"].GetDouble();
+  };
+  double mapped = doc["metrics"]["normal"]["meanDeg"].GetDouble();
+  EXPECT_LT(mapped, meanDeg("smooth"));
+  EXPECT_LT(2 * mapped, meanDeg("flat"));
+}
+
 struct BadRequest {
   const char* name;
   std::string method, path, body;
@@ -159,6 +196,16 @@ TEST_F(ServerTest, EveryBadRequestGetsItsJsonErrorAndTheServerCarriesOn) {
       {"face index out of range", "POST", "/v1/render",
        R"({"mesh": {"format": "obj", "data": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"}})", 422,
        "invalid_mesh"},
+      {"contours from another method", "POST", "/v1/render",
+       renderBody("adaptive", 64, R"(, "outputs": ["contours"])"), 400, "invalid_request"},
+      {"bad presubdivide", "POST", "/v1/render",
+       renderBody("silhouette", 64, R"(, "params": {"presubdivide": 2})"), 400, "invalid_request"},
+      {"bad contour", "POST", "/v1/render",
+       renderBody("silhouette", 64, R"(, "params": {"contour": "spline"})"), 400, "invalid_request"},
+      {"too many search steps", "POST", "/v1/render",
+       renderBody("silhouette", 64, R"(, "params": {"searchSteps": 1000})"), 413, "too_large"},
+      {"normal-map on uniform", "POST", "/v1/render",
+       renderBody("uniform", 64, R"(, "shading": "normal-map")"), 400, "invalid_request"},
       {"unknown path", "GET", "/v2/everything", "", 404, "not_found"},
       {"wrong verb", "GET", "/v1/render", "", 405, "method_not_allowed"},
       {"wrong verb on healthz", "POST", "/healthz", "{}", 405, "method_not_allowed"},
