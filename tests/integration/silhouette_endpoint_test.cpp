@@ -384,5 +384,20 @@ TEST_F(SilhouetteEndpointTest, BadRequestsName400FieldsAndTheServerCarriesOn) {
             std::string::npos);
 }
 
+TEST_F(SilhouetteEndpointTest, OpenApiDocumentDescribesTheEndpoint) {
+  HttpResponse r = get(port(), "/openapi.json");
+  ASSERT_EQ(r.status, 200);
+  auto doc = parseJson(r.body);
+  ASSERT_FALSE(doc.HasParseError());
+  ASSERT_TRUE(doc["paths"].HasMember("/v1/silhouette"));
+  const auto& post = doc["paths"]["/v1/silhouette"]["post"];
+  EXPECT_TRUE(post["responses"]["200"]["content"].HasMember("image/svg+xml"));
+  EXPECT_TRUE(post["responses"]["200"]["content"].HasMember("application/json"));
+  for (const char* schema : {"SilhouetteRequest", "SilhouetteResponse", "ContourPolyline",
+                             "ContourPoint", "ContourPiece"}) {
+    EXPECT_TRUE(doc["components"]["schemas"].HasMember(schema)) << schema;
+  }
+}
+
 }  // namespace
 }  // namespace limn::testing
