@@ -140,8 +140,10 @@ void parseSilhouetteParams(const Value& params, const JobLimits& limits,
 render::pipeline::MethodParams parseParams(const Value& params, const JobLimits& limits,
                                            std::vector<std::string>& warnings) {
   json::requireObject(params, "params");
-  warnUnknownFields(params, "params", {"level", "dicingRate", "metricSupersample", "presubdivide",
-                                       "searchSteps", "curveSamples", "contour"}, warnings);
+  warnUnknownFields(params, "params",
+                    {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample",
+                     "presubdivide", "searchSteps", "curveSamples", "contour"},
+                    warnings);
   render::pipeline::MethodParams out;
   if (const Value* v = json::find(params, "level")) {
     out.level = json::integer(*v, "params.level");
@@ -151,6 +153,16 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
                      "params.level " + std::to_string(out.level) + " exceeds limit maxLevel (" +
                          std::to_string(limits.maxLevel) + ")");
     }
+  }
+  if (const Value* v = json::find(params, "engine")) {
+    using render::pipeline::Engine;
+    out.engine = json::choice<Engine>(*v, "params.engine",
+                                      {{"opensubdiv", Engine::OpenSubdiv},
+                                       {"masks", Engine::Masks},
+                                       {"factored", Engine::Factored}});
+  }
+  if (const Value* v = json::find(params, "pushToLimit")) {
+    out.pushToLimit = json::boolean(*v, "params.pushToLimit");
   }
   if (const Value* v = json::find(params, "dicingRate")) {
     out.dicingRate = json::number(*v, "params.dicingRate");
@@ -182,7 +194,7 @@ render::pipeline::Outputs parseOutputs(const Value& value) {
   json::requireArray(value, "outputs");
   render::pipeline::Outputs out;
   out.color = false;
-  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours };
+  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours, Cage };
   for (rapidjson::SizeType i = 0; i < value.Size(); ++i) {
     Pass pass = json::choice<Pass>(value[i], "outputs[" + std::to_string(i) + "]",
                                    {{"color", Color},
@@ -190,9 +202,10 @@ render::pipeline::Outputs parseOutputs(const Value& value) {
                                     {"depth", Depth},
                                     {"normal", Normal},
                                     {"wireframe", Wireframe},
-                                    {"contours", Contours}});
+                                    {"contours", Contours},
+                                    {"cage", Cage}});
     bool* flags[] = {&out.color, &out.mask, &out.depth, &out.normal, &out.wireframe,
-                     &out.contours};
+                     &out.contours, &out.cage};
     *flags[pass] = true;
   }
   return out;
@@ -253,6 +266,15 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
   if (const Value* v = json::find(root, "outputs")) job.outputs = parseOutputs(*v);
   if (job.outputs.contours && job.method != Method::Silhouette) {
     json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
+  }
+  if (job.outputs.cage && job.method == Method::Limit) {
+    json::fail("outputs", "output \"cage\" is drawn over a method's own image; method \"limit\" "
+                          "has none");
+  }
+  if (job.method != Method::Uniform &&
+      (job.params.engine != render::pipeline::Engine::OpenSubdiv || job.params.pushToLimit)) {
+    warnings.push_back("params.engine and params.pushToLimit are read by method \"uniform\" "
+                       "only; ignored");
   }
   if (const Value* v = json::find(root, "reference"))
     job.reference = json::boolean(*v, "reference");

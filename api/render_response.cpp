@@ -29,6 +29,7 @@ std::vector<const char*> requestedPasses(const Outputs& outputs) {
   if (outputs.normal) names.push_back(render::pass::kNormal);
   if (outputs.wireframe) names.push_back(render::pass::kWireframe);
   if (outputs.contours) names.push_back(render::pass::kContours);
+  if (outputs.cage) names.push_back(render::pass::kCage);
   return names;
 }
 
@@ -36,8 +37,10 @@ void writeImages(Writer& w, const render::ImageSet& images, const RenderRequest&
                  const char* owner, std::vector<std::string>& warnings) {
   w.StartObject();
   for (const char* name : requestedPasses(request.job.outputs)) {
-    // The contour overlay belongs to the silhouette method; the reference has none.
-    if (std::string_view(owner) == "reference" && std::string_view(name) == render::pass::kContours) {
+    // The contour and cage overlays are drawn over the method's image; the reference has none.
+    if (std::string_view(owner) == "reference" &&
+        (std::string_view(name) == render::pass::kContours ||
+         std::string_view(name) == render::pass::kCage)) {
       continue;
     }
     const render::Image* image = images.find(name);
