@@ -2,7 +2,8 @@
 // (the grazing rays do not hide it, "pn" curves off the surface included), a far blob's outline
 // is hidden exactly where a near blob covers it, and a torus seen nearly edge-on hides part of
 // its inner outline behind its near tube. The last two are checked against the reference's own
-// depth image (its primary rays), an independent path to the same answer.
+// depth image (its primary rays), an independent path to the same answer, in perspective and
+// orthographic views.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -202,6 +203,25 @@ TEST(ContourVisibility, FarBlobIsHiddenWhereTheNearOneCoversIt) {
   EXPECT_GT(exposed, 100u);
   std::printf("two blobs: %zu contour points, %zu of the far outline hidden, %zu covered\n",
               c.points.size(), hiddenFar, coveredFar);
+}
+
+TEST(ContourVisibility, OrthographicRaysRunAlongTheViewDirection) {
+  // The same two blobs seen orthographically: the near one no longer looks larger, so move it
+  // to cover part of the far one's outline.
+  Camera view({0, 0.2, 8}, {0, 0, 0}, {0, 1, 0}, 35, Projection::Orthographic, 3.0, 512, 512,
+              0.1, 100);
+  ControlMesh blobs = twoCubes({0.35, 0.1, 1.5}, {0, 0, -1.5});
+  Contours c = contours(blobs, view);
+  ASSERT_EQ(c.lines.size(), 2u);
+  size_t hiddenNear = 0, hiddenFar = 0;
+  for (size_t i = 0; i < c.points.size(); ++i) {
+    (c.points[i].position.z > 0 ? hiddenNear : hiddenFar) += !c.visible[i];
+  }
+  EXPECT_EQ(hiddenNear, 0u);
+  EXPECT_GT(hiddenFar, 10u);
+  auto [covered, exposed] = expectAgreesWithReferenceDepth(blobs, view, c, 0.5);
+  EXPECT_GT(covered, 10u);
+  EXPECT_GT(exposed, 100u);
 }
 
 TEST(ContourVisibility, NearlyEdgeOnTorusHidesPartOfItsInnerOutline) {
