@@ -261,7 +261,10 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
   if (const Value* v = json::find(root, "params")) job.params = parseParams(*v, limits, warnings);
   if (const Value* v = json::find(root, "shading")) {
     job.shading = json::choice<render::Shading>(
-        *v, "shading", {{"flat", render::Shading::Flat}, {"smooth", render::Shading::Smooth}});
+        *v, "shading",
+        {{"flat", render::Shading::Flat},
+         {"smooth", render::Shading::Smooth},
+         {"normal-map", render::Shading::NormalMap}});
   }
   if (const Value* v = json::find(root, "outputs")) job.outputs = parseOutputs(*v);
   if (job.outputs.contours && job.method != Method::Silhouette) {

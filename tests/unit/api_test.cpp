@@ -728,15 +728,14 @@ TEST(RenderRequest, WrongTypesNameTheField) {
 TEST(RenderRequest, UnknownMethodAndOutputListTheValidNames) {
   ApiError method = parseError(cubeRequest(R"(, "method": "magic")"));
   expectError(method, 400, "invalid_request");
-  EXPECT_TRUE(contains(method.message, R"("coarse", "uniform", "adaptive", "limit")"))
+  EXPECT_TRUE(
+      contains(method.message, R"("coarse", "uniform", "adaptive", "limit", "silhouette")"))
       << method.message;
   EXPECT_TRUE(contains(method.message, "\"magic\"")) << method.message;
 
-  for (const char* later : {"silhouette", "patches"}) {
-    ApiError e = parseError(cubeRequest(std::string(R"(, "method": ")") + later + "\""));
-    expectError(e, 400, "invalid_request");
-    EXPECT_TRUE(contains(e.message, "not implemented yet")) << e.message;
-  }
+  ApiError later = parseError(cubeRequest(R"(, "method": "patches")"));
+  expectError(later, 400, "invalid_request");
+  EXPECT_TRUE(contains(later.message, "not implemented yet")) << later.message;
 
   ApiError output = parseError(cubeRequest(R"(, "outputs": ["color", "albedo"])"));
   expectError(output, 400, "invalid_request");
