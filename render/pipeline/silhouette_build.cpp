@@ -1,5 +1,7 @@
 #include "render/pipeline/silhouette_build.h"
 
+#include "render/core/error.h"
+
 namespace limn::render::pipeline {
 
 SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camera& camera,
@@ -18,7 +20,23 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
         "(Catmull-Clark) or triangles (Loop) only, so the mesh was refined once");
   }
   SilhouetteBuild out;
-  if (refine) out.presubdivided = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh));
+  if (refine) {
+    try {
+      out.presubdivided =
+          std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh));
+    } catch (const InputError& e) {
+      // Refining some non-manifold meshes makes interior vertices of valence 2, which the
+      // OpenSubdiv version limn runs on cannot evaluate around. Draw the mesh unrefined if the
+      // method can; otherwise say why in terms of the mesh the client sent.
+      if (!silhouette::hasSimpleFaces(mesh)) {
+        throw InputError(InputError::Kind::InvalidMesh, "presubdivide",
+                         std::string("the silhouette method must refine this mesh once (it has "
+                                     "faces other than quads or triangles), and the refined "
+                                     "mesh cannot be evaluated: ") + e.what());
+      }
+      warnings.push_back(std::string("pre-subdivision skipped: ") + e.what());
+    }
+  }
 
   silhouette::SilhouetteOptions options;
   options.search.searchSteps = params.searchSteps;
