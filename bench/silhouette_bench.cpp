@@ -151,14 +151,22 @@ int main(int argc, char** argv) {
       std::printf("## %s\n\nskipped: %s\n\n", shape.name.c_str(), e.what());
       continue;
     }
+    std::unique_ptr<subdiv::LimitSurface> refined;
+    const bool presub = !silhouette::presubdivisionReason(shape.mesh).empty() ||
+                        !silhouette::hasSimpleFaces(shape.mesh);
+    try {
+      if (presub) {
+        refined = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(shape.mesh));
+      }
+    } catch (const std::exception& e) {
+      std::printf("## %s\n\nskipped: the pre-subdivided mesh is refused: %s\n\n",
+                  shape.name.c_str(), e.what());
+      continue;
+    }
     const Camera camera = obliqueCamera(surface->bounds(), size);
     PassSelection refPasses{.mask = true, .supersample = S};
     oracle::ReferenceResult reference =
         oracle::renderReference(*surface, camera, refPasses, CancelToken());
-    std::unique_ptr<subdiv::LimitSurface> refined;
-    const bool presub = !silhouette::presubdivisionReason(shape.mesh).empty() ||
-                        !silhouette::hasSimpleFaces(shape.mesh);
-    if (presub) refined = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(shape.mesh));
     const subdiv::LimitSurface& drawn = refined ? *refined : *surface;
 
     using Build = std::function<tessellate::TriangleMesh()>;
