@@ -101,6 +101,12 @@ Refined refineWithRules(const mesh::ControlMesh& cage, int level, rules::Method 
   out.faceOffsets = std::move(refined.topology.faceOffsets);
   out.faceVertices = std::move(refined.topology.faceVertices);
   out.hole = std::move(refined.topology.faceHole);
+  if (level == 0) {
+    // Level 0 is the cage, drawn as the OpenSubdiv engine draws it (tessellateCoarse): only
+    // the mesh's own holes are left out, not the faces "none" boundaries give no limit.
+    out.hole.assign(out.hole.size(), 0);
+    for (int f : cage.holes) out.hole[f] = 1;
+  }
   return out;
 }
 

@@ -94,6 +94,11 @@ TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
     UniformOptions options;
     options.level = 2;
     TriangleMesh far = tessellateUniform(surface, options);
+    // Level 0 is the cage for every engine (only the normals come from different evaluators).
+    options.engine = UniformEngine::Masks;
+    options.level = 0;
+    EXPECT_EQ(tessellateUniform(surface, options).indices, tessellateCoarse(surface).indices);
+    options.level = 2;
     for (UniformEngine engine : {UniformEngine::Masks, UniformEngine::Factored}) {
       if (engine == UniformEngine::Factored && (cage.scheme == mesh::Scheme::Loop ||
                                                 !cage.creases.empty())) {
