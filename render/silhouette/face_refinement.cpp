@@ -13,12 +13,27 @@ namespace {
 using Edge = std::pair<int, int>;
 Edge key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
 
+// True when the segment a-b runs along one side of the face's domain (the unit square, or
+// the triangle u, v >= 0, u + v <= 1): splitting it would put a point on the face's boundary
+// that the neighbour does not have.
+bool alongDomainSide(const Vec2& a, const Vec2& b, bool triangle) {
+  const double eps = 1e-9;
+  auto both = [&](auto onSide) { return onSide(a) && onSide(b); };
+  if (both([&](const Vec2& p) { return std::fabs(p.x) < eps; })) return true;
+  if (both([&](const Vec2& p) { return std::fabs(p.y) < eps; })) return true;
+  if (triangle) return both([&](const Vec2& p) { return std::fabs(p.x + p.y - 1) < eps; });
+  return both([&](const Vec2& p) { return std::fabs(p.x - 1) < eps; }) ||
+         both([&](const Vec2& p) { return std::fabs(p.y - 1) < eps; });
+}
+
 }  // namespace
 
 int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camera, int face,
                         int boundaryCount, const std::vector<std::vector<int>>& lockedChains,
                         double tolerancePx, int maxSplits, std::vector<FacePoint>& points,
                         std::vector<std::array<int, 3>>& triangles) {
+  const bool triangle = surface.parameterization(face).GetType() ==
+                        OpenSubdiv::Bfr::Parameterization::TRI;
   std::set<Edge> locked;
   for (int i = 0; i < boundaryCount; ++i) locked.insert(key(i, (i + 1) % boundaryCount));
   for (const std::vector<int>& chain : lockedChains) {
@@ -38,6 +53,27 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
     return std::hypot(c.x - m.x, c.y - m.y);
   };
 
+  // A split must leave the triangulation a tiling of the same domain; if numerical trouble
+  // (points almost on top of each other near a crease) ever breaks that, the face keeps the
+  // triangles it came with.
+  auto uvArea = [&](const std::array<int, 3>& t) {
+    const Vec2 &a = points[t[0]].uv, &b = points[t[1]].uv, &c = points[t[2]].uv;
+    return 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+  };
+  auto tiling = [&](double* total) {
+    *total = 0;
+    for (const auto& t : triangles) {
+      double area = uvArea(t);
+      if (!(area > 0)) return false;
+      *total += area;
+    }
+    return true;
+  };
+  double areaBefore = 0;
+  const bool tiledBefore = tiling(&areaBefore);
+  const std::vector<std::array<int, 3>> original = triangles;
+  const size_t originalPoints = points.size();
+
   int splits = 0;
   std::set<Edge> checked;  // interior edges found fine (their chord is within tolerance)
   while (splits < maxSplits) {
@@ -50,7 +86,9 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
         Edge e = key(t[k], t[(k + 1) % 3]);
         if (locked.count(e) || checked.count(e)) continue;
         const Vec2 &ua = points[e.first].uv, &ub = points[e.second].uv;
-        if (std::hypot(ua.x - ub.x, ua.y - ub.y) < 1e-6) {  // too short to split further
+        if (std::hypot(ua.x - ub.x, ua.y - ub.y) < 1e-6 ||  // too short to split further
+            length(points[e.first].position - points[e.second].position) < 1e-9 ||
+            alongDomainSide(ua, ub, triangle)) {
           checked.insert(e);
           continue;
         }
@@ -82,6 +120,32 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
       }
     }
     ++splits;
+  }
+  // In 3D, no edge may be shared by more than two triangles (that would be a fold, which the
+  // surface pinching near a crease has produced).
+  auto folded = [&] {
+    using Key = std::pair<std::array<float, 3>, std::array<float, 3>>;
+    std::map<Key, int> uses;
+    auto at = [&](int i) {
+      const Vec3& p = points[i].position;
+      return std::array<float, 3>{static_cast<float>(p.x), static_cast<float>(p.y),
+                                  static_cast<float>(p.z)};
+    };
+    for (const auto& t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        auto a = at(t[k]), b = at(t[(k + 1) % 3]);
+        if (++uses[std::minmax(a, b)] > 2) return true;
+      }
+    }
+    return false;
+  };
+  double areaAfter = 0;
+  if (splits > 0 && tiledBefore &&
+      (!tiling(&areaAfter) || std::fabs(areaAfter - areaBefore) > 1e-9 * areaBefore ||
+       folded())) {
+    triangles = original;
+    points.resize(originalPoints);
+    return 0;
   }
   return splits;
 }

@@ -104,7 +104,14 @@ FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
   piece.triangles = triangulateFace(uv, static_cast<int>(boundary.points.size()), paths);
   // Only exact curves lie on the surface; a chord ending at a pn sample (off the surface) would
   // never come within tolerance, so pn faces keep their ear-clipped triangles.
-  if (!paths.empty() && options.curves.mode == CurveMode::Exact) {
+  // Faces along an infinitely sharp edge are left as clipped: the surface can pinch there
+  // (two (u, v) points on one position), and splitting towards it folded triangles over each
+  // other in tests.
+  bool sharpSide = false;
+  for (int e : surface.baseLevel().GetFaceEdges(face)) {
+    sharpSide = sharpSide || surface.baseLevel().GetEdgeSharpness(e) >= mesh::kInfiniteSharpness;
+  }
+  if (!paths.empty() && options.curves.mode == CurveMode::Exact && !sharpSide) {
     std::vector<std::vector<int>> chains;
     for (const CurvePath& path : paths) {
       std::vector<int> chain{path.from};
