@@ -1,5 +1,7 @@
 #include "api/answer.h"
 
+#include <new>
+
 #include <rapidjson/stringbuffer.h>
 #include <rapidjson/writer.h>
 
@@ -59,6 +61,36 @@ ApiError fromInputError(const render::InputError& error) {
       return invalidRequest(error.subject(), error.what());
   }
   return {500, "internal", error.what()};
+}
+
+Answer answerOrError(const std::string& what, const std::function<Answer()>& work) {
+  try {
+    try {
+      return work();
+    } catch (const ApiError& error) {
+      return errorAnswer(error);
+    } catch (const render::InputError& error) {
+      return errorAnswer(fromInputError(error));
+    } catch (const render::Cancelled&) {
+      return errorAnswer({504, "timeout",
+                          "the " + what +
+                              " did not finish within the request time limit "
+                              "(requestTimeoutMs), or the server is shutting down"});
+    } catch (const std::bad_alloc&) {
+      return errorAnswer(
+          {413, "too_large", "request needs more memory than available", R"({"limit": "memory"})"});
+    } catch (const std::exception& error) {
+      return errorAnswer({500, "internal", error.what()});
+    } catch (...) {
+      return errorAnswer({500, "internal", "unknown error"});
+    }
+  } catch (...) {
+    // Building the error answer itself failed (out of memory): a fixed body still answers.
+    Answer answer;
+    answer.status = 500;
+    answer.body = R"({"error":{"code":"internal","message":"out of memory","detail":{}}})";
+    return answer;
+  }
 }
 
 }  // namespace limn::api

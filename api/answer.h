@@ -3,6 +3,7 @@
 // errorAnswer() turns it into the JSON error body every failure uses.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,5 +43,10 @@ ApiError invalidMesh(const std::string& subject, const std::string& message);
 // InvalidMesh -> 422 invalid_mesh, LimitExceeded -> 413 too_large, InvalidParameter -> 400
 // invalid_request; the InputError's subject goes into the detail.
 ApiError fromInputError(const render::InputError& error);
+
+// Runs `work` and turns every failure into its JSON error answer: ApiError as it is,
+// InputError through fromInputError, Cancelled -> 504 ("the `what` did not finish within the
+// request time limit ..."), bad_alloc -> 413, anything else -> 500. Never throws.
+Answer answerOrError(const std::string& what, const std::function<Answer()>& work);
 
 }  // namespace limn::api

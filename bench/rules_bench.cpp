@@ -28,12 +28,11 @@
 #include <vector>
 
 #include <opensubdiv/far/primvarRefiner.h>
-#include <opensubdiv/far/topologyDescriptor.h>
-#include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "api/obj_reader.h"
 #include "render/rules/limit.h"
 #include "render/rules/refine.h"
+#include "render/subdiv/limit_surface.h"
 #include "tests/unit/test_meshes.h"
 
 namespace fs = std::filesystem;
@@ -67,41 +66,6 @@ struct Point {
   }
 };
 
-std::unique_ptr<Far::TopologyRefiner> farRefiner(const ControlMesh& m) {
-  std::vector<int> creaseVertices, cornerVertices;
-  std::vector<float> creaseWeights, cornerWeights;
-  for (const auto& c : m.creases) {
-    creaseVertices.insert(creaseVertices.end(), {c.v0, c.v1});
-    creaseWeights.push_back(c.sharpness);
-  }
-  for (const auto& c : m.corners) {
-    cornerVertices.push_back(c.vertex);
-    cornerWeights.push_back(c.sharpness);
-  }
-  Far::TopologyDescriptor desc;
-  desc.numVertices = m.vertexCount();
-  desc.numFaces = m.faceCount();
-  desc.numVertsPerFace = m.faceVertexCounts.data();
-  desc.vertIndicesPerFace = m.faceVertexIndices.data();
-  desc.numCreases = static_cast<int>(m.creases.size());
-  desc.creaseVertexIndexPairs = creaseVertices.data();
-  desc.creaseWeights = creaseWeights.data();
-  desc.numCorners = static_cast<int>(m.corners.size());
-  desc.cornerVertexIndices = cornerVertices.data();
-  desc.cornerWeights = cornerWeights.data();
-  desc.numHoles = static_cast<int>(m.holes.size());
-  desc.holeIndices = m.holes.data();
-  Sdc::Options options;
-  options.SetVtxBoundaryInterpolation(
-      m.boundary == render::mesh::BoundaryInterpolation::None ? Sdc::Options::VTX_BOUNDARY_NONE
-      : m.boundary == render::mesh::BoundaryInterpolation::EdgeOnly
-          ? Sdc::Options::VTX_BOUNDARY_EDGE_ONLY
-          : Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
-  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  Sdc::SchemeType type = m.scheme == Scheme::Loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
-  return std::unique_ptr<Far::TopologyRefiner>(Factory::Create(desc, Factory::Options(type, options)));
-}
-
 // Far's refinement: the refiner (kept for Limit) and the points of every level.
 struct FarRun {
   std::unique_ptr<Far::TopologyRefiner> refiner;
@@ -111,7 +75,7 @@ struct FarRun {
 
 FarRun farRefine(const ControlMesh& m, int level) {
   FarRun run;
-  run.refiner = farRefiner(m);
+  run.refiner = render::subdiv::createTopologyRefiner(m);
   Far::TopologyRefiner::UniformOptions options(level);
   options.fullTopologyInLastLevel = true;
   run.refiner->RefineUniform(options);

@@ -224,7 +224,9 @@ int main(int argc, char** argv) {
       rows.push_back(row);
     }
 
-    Summary summary{shape.name, classify(*surface)};
+    Summary summary;
+    summary.shape = shape.name;
+    summary.kind = classify(*surface);
     std::printf("## %s (%s, %d faces%s)\n\n", shape.name.c_str(), summary.kind.c_str(),
                 shape.mesh.faceCount(), presub ? ", silhouette pre-subdivided" : "");
     std::printf("| method | triangles | hausdorffPx | meanPx | ms |\n|---|---:|---:|---:|---:|\n");

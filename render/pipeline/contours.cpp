@@ -4,6 +4,7 @@
 #include <string>
 
 #include "render/core/error.h"
+#include "render/pipeline/job_checks.h"
 #include "render/oracle/visibility.h"
 #include "render/subdiv/limit_surface.h"
 
@@ -11,40 +12,11 @@ namespace limn::render::pipeline {
 
 namespace {
 
-class Stopwatch {
- public:
-  double lapMs() {
-    auto now = std::chrono::steady_clock::now();
-    double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-[[noreturn]] void badParameter(const std::string& name, const std::string& message) {
-  throw InputError(InputError::Kind::InvalidParameter, name, name + " " + message);
-}
-
 // The engine checks its limits itself rather than trusting its caller (as run() does).
 void checkJob(const ContourJob& job, const JobLimits& limits) {
   const SilhouetteParams& p = job.params;
-  if (p.searchSteps < 0 || p.searchSteps > limits.maxSearchSteps) {
-    badParameter("params.searchSteps", "must be in 0.." + std::to_string(limits.maxSearchSteps));
-  }
-  if (p.curveSamples < 0 || p.curveSamples > limits.maxCurveSamples) {
-    badParameter("params.curveSamples",
-                 "must be in 0.." + std::to_string(limits.maxCurveSamples));
-  }
-  for (const std::optional<int>& side : {job.camera.width, job.camera.height}) {
-    if (side && (*side < 1 || *side > limits.maxImageSide)) {
-      throw InputError(InputError::Kind::LimitExceeded, "maxImageSide",
-                       "image side " + std::to_string(*side) + " exceeds limit maxImageSide " +
-                           std::to_string(limits.maxImageSide));
-    }
-  }
+  checkSilhouetteParams(p.searchSteps, p.curveSamples, limits);
+  checkImageSides(job.camera, limits);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <string>
 
 #include "render/core/error.h"
+#include "render/pipeline/job_checks.h"
 #include "render/oracle/reference.h"
 #include "render/pipeline/render_job.h"
 #include "render/pipeline/silhouette_build.h"
@@ -17,23 +18,6 @@
 namespace limn::render::pipeline {
 
 namespace {
-
-class Stopwatch {
- public:
-  double lapMs() {
-    auto now = std::chrono::steady_clock::now();
-    double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-[[noreturn]] void badParameter(const std::string& name, const std::string& message) {
-  throw InputError(InputError::Kind::InvalidParameter, name, name + " " + message);
-}
 
 void checkJob(const RenderJob& job, const JobLimits& limits) {
   const MethodParams& p = job.params;
@@ -56,24 +40,12 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
   if (!(p.dicingRate >= limits.minDicingRate)) {
     badParameter("params.dicingRate", "must be >= " + std::to_string(limits.minDicingRate));
   }
-  if (p.searchSteps < 0 || p.searchSteps > limits.maxSearchSteps) {
-    badParameter("params.searchSteps", "must be in 0.." + std::to_string(limits.maxSearchSteps));
-  }
-  if (p.curveSamples < 0 || p.curveSamples > limits.maxCurveSamples) {
-    badParameter("params.curveSamples",
-                 "must be in 0.." + std::to_string(limits.maxCurveSamples));
-  }
+  checkSilhouetteParams(p.searchSteps, p.curveSamples, limits);
   if (p.metricSupersample < 1 || p.metricSupersample > limits.maxSupersample) {
     badParameter("params.metricSupersample",
                  "must be in 1.." + std::to_string(limits.maxSupersample));
   }
-  for (const std::optional<int>& side : {job.camera.width, job.camera.height}) {
-    if (side && (*side < 1 || *side > limits.maxImageSide)) {
-      throw InputError(InputError::Kind::LimitExceeded, "maxImageSide",
-                       "image side " + std::to_string(*side) + " exceeds limit maxImageSide " +
-                           std::to_string(limits.maxImageSide));
-    }
-  }
+  checkImageSides(job.camera, limits);
 }
 
 // Normal-map shading: an atlas of the limit normals of `surface`'s faces, sized so the face

@@ -66,7 +66,9 @@ Sdc::Options schemeOptions(const mesh::ControlMesh& m) {
   return options;
 }
 
-std::unique_ptr<Far::TopologyRefiner> makeRefiner(const mesh::ControlMesh& m) {
+}  // namespace
+
+std::unique_ptr<Far::TopologyRefiner> createTopologyRefiner(const mesh::ControlMesh& m) {
   installFarErrorCallback();
   std::vector<int> creaseVertices;
   std::vector<float> creaseWeights;
@@ -108,10 +110,8 @@ std::unique_ptr<Far::TopologyRefiner> makeRefiner(const mesh::ControlMesh& m) {
   return refiner;
 }
 
-}  // namespace
-
 LimitSurface::LimitSurface(mesh::ControlMesh mesh)
-    : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(makeRefiner(mesh_)) {
+    : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(createTopologyRefiner(mesh_)) {
   rejectUnsupportedTopology();
   buildFaceSurfaces();
   computeControlLimits();
@@ -120,7 +120,7 @@ LimitSurface::LimitSurface(mesh::ControlMesh mesh)
 LimitSurface::~LimitSurface() = default;
 
 std::unique_ptr<Far::TopologyRefiner> LimitSurface::createRefiner() const {
-  return makeRefiner(mesh_);
+  return createTopologyRefiner(mesh_);
 }
 
 const Far::TopologyLevel& LimitSurface::baseLevel() const { return refiner_->GetLevel(0); }

@@ -32,6 +32,12 @@ struct LimitSample {
   Vec3 normal;  // unit; cross(du, dv) oriented by the face winding
 };
 
+// A Far topology refiner for `mesh` with its scheme, tags and rules (what LimitSurface is built
+// on; also what anything comparing against OpenSubdiv should refine with). Throws
+// InputError(InvalidMesh) when OpenSubdiv rejects the topology.
+std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> createTopologyRefiner(
+    const mesh::ControlMesh& mesh);
+
 class LimitSurface {
  public:
   // Throws InputError(InvalidMesh) when OpenSubdiv cannot build the topology, or when it has

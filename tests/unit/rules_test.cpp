@@ -15,8 +15,6 @@
 #include <sstream>
 
 #include <opensubdiv/far/primvarRefiner.h>
-#include <opensubdiv/far/topologyDescriptor.h>
-#include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "api/obj_reader.h"
 #include "render/core/error.h"
@@ -112,48 +110,6 @@ struct FarPoint {
   Vec3 vec() const { return {x, y, z}; }
 };
 
-std::unique_ptr<Far::TopologyRefiner> farRefiner(const ControlMesh& m) {
-  std::vector<int> creaseVertices, cornerVertices;
-  std::vector<float> creaseWeights, cornerWeights;
-  for (const mesh::Crease& c : m.creases) {
-    creaseVertices.insert(creaseVertices.end(), {c.v0, c.v1});
-    creaseWeights.push_back(c.sharpness);
-  }
-  for (const mesh::Corner& c : m.corners) {
-    cornerVertices.push_back(c.vertex);
-    cornerWeights.push_back(c.sharpness);
-  }
-  Far::TopologyDescriptor desc;
-  desc.numVertices = m.vertexCount();
-  desc.numFaces = m.faceCount();
-  desc.numVertsPerFace = m.faceVertexCounts.data();
-  desc.vertIndicesPerFace = m.faceVertexIndices.data();
-  desc.numCreases = static_cast<int>(m.creases.size());
-  desc.creaseVertexIndexPairs = creaseVertices.data();
-  desc.creaseWeights = creaseWeights.data();
-  desc.numCorners = static_cast<int>(m.corners.size());
-  desc.cornerVertexIndices = cornerVertices.data();
-  desc.cornerWeights = cornerWeights.data();
-  desc.numHoles = static_cast<int>(m.holes.size());
-  desc.holeIndices = m.holes.data();
-
-  Sdc::Options options;
-  options.SetVtxBoundaryInterpolation(
-      m.boundary == mesh::BoundaryInterpolation::None       ? Sdc::Options::VTX_BOUNDARY_NONE
-      : m.boundary == mesh::BoundaryInterpolation::EdgeOnly ? Sdc::Options::VTX_BOUNDARY_EDGE_ONLY
-                                                            : Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
-  options.SetCreasingMethod(m.creaseMethod == mesh::CreaseMethod::Chaikin
-                                ? Sdc::Options::CREASE_CHAIKIN
-                                : Sdc::Options::CREASE_UNIFORM);
-  options.SetTriangleSubdivision(m.triangleSubdivision == mesh::TriangleSubdivision::Smooth
-                                     ? Sdc::Options::TRI_SUB_SMOOTH
-                                     : Sdc::Options::TRI_SUB_CATMARK);
-  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  Sdc::SchemeType type = m.scheme == Scheme::Loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
-  return std::unique_ptr<Far::TopologyRefiner>(
-      Factory::Create(desc, Factory::Options(type, options)));
-}
-
 // Far's uniform refinement to `levels`: the points of every level, in double precision.
 struct FarLevels {
   std::unique_ptr<Far::TopologyRefiner> refiner;
@@ -162,7 +118,7 @@ struct FarLevels {
 
 FarLevels farRefine(const ControlMesh& m, int levels) {
   FarLevels out;
-  out.refiner = farRefiner(m);
+  out.refiner = render::subdiv::createTopologyRefiner(m);
   Far::TopologyRefiner::UniformOptions options(levels);
   options.fullTopologyInLastLevel = true;
   out.refiner->RefineUniform(options);

@@ -1,0 +1,37 @@
+// What run() and runContours() share before they start: a stopwatch for the timings and the
+// checks of request values against JobLimits (the engine checks its limits itself rather than
+// trusting its caller).
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include "render/core/camera.h"
+#include "render/pipeline/render_job.h"
+
+namespace limn::render::pipeline {
+
+// Milliseconds since construction or the previous lap.
+class Stopwatch {
+ public:
+  double lapMs() {
+    auto now = std::chrono::steady_clock::now();
+    double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// Throws InputError(InvalidParameter) naming `name`.
+[[noreturn]] void badParameter(const std::string& name, const std::string& message);
+
+// params.searchSteps and params.curveSamples of the silhouette method.
+void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& limits);
+
+// camera.width and camera.height against maxImageSide (LimitExceeded).
+void checkImageSides(const CameraSpec& camera, const JobLimits& limits);
+
+}  // namespace limn::render::pipeline
