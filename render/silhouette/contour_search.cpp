@@ -45,14 +45,8 @@ EdgeInFace locateEdge(const Far::TopologyLevel& base, int face, int edge) {
 class EdgeProbe {
  public:
   EdgeProbe(const subdiv::LimitSurface& surface, const Camera& camera, int face, int edge)
-      : surface_(surface), camera_(camera), face_(face) {
-    EdgeInFace where = locateEdge(surface.baseLevel(), face, edge);
-    int n = surface.mesh().faceVertexCounts[face];
-    Vec2 a = surface.cornerUV(face, where.corner);
-    Vec2 b = surface.cornerUV(face, (where.corner + 1) % n);
-    from_ = where.forward ? a : b;
-    to_ = where.forward ? b : a;
-  }
+      : surface_(surface), camera_(camera), face_(face),
+        from_(edgeUV(surface, face, edge, 0.0)), to_(edgeUV(surface, face, edge, 1.0)) {}
 
   double g(double t) const {
     subdiv::LimitSample s = surface_.evaluate(face_, from_.x + (to_.x - from_.x) * t,

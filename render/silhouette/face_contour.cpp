@@ -171,17 +171,16 @@ FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSear
   const size_t offset = search.faceOffsets[face];
   FaceBoundary out;
   out.face = face;
-  auto push = [&](const FacePoint& p, bool crossing, int corner, int edge, int edgePoint) {
+  auto push = [&](const FacePoint& p, bool crossing, int edge, int edgePoint) {
     out.points.push_back(p);
     out.crossing.push_back(crossing);
-    out.corner.push_back(corner);
     out.edge.push_back(edge);
     out.edgePoint.push_back(edgePoint);
   };
   for (int k = 0; k < verts.size(); ++k) {
     push({surface.cornerUV(face, k), surface.controlLimitPositions()[verts[k]],
           search.cornerNormals[offset + k]},
-         false, k, -1, -1);
+         false, -1, -1);
     const int e = edges[k];
     const std::vector<EdgePoint>& points = search.edgePoints[e];
     if (points.empty()) continue;
@@ -193,7 +192,7 @@ FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSear
       size_t i = forward ? j : points.size() - 1 - j;
       Vec2 uv = edgeUV(surface, face, e, points[i].t);
       push({uv, points[i].position, surface.evaluate(face, uv.x, uv.y).normal},
-           bit < 32 && (points[i].sides >> bit & 1u), -1, e, static_cast<int>(i));
+           bit < 32 && (points[i].sides >> bit & 1u), e, static_cast<int>(i));
       ++out.edgePointCount;
     }
   }

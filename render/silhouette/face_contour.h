@@ -37,7 +37,6 @@ struct FaceBoundary {
   int face = -1;
   std::vector<FacePoint> points;
   std::vector<bool> crossing;
-  std::vector<int> corner;  // corner index for corner points, -1 for edge points
   std::vector<int> edge;    // base edge holding each edge point (-1 for corners)
   std::vector<int> edgePoint;  // index into ContourSearch::edgePoints[edge], -1 for corners
   int edgePointCount = 0;
