@@ -128,6 +128,7 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.integer("ioThreads", config.ioThreads, 1, 256);
   r.size("maxBodyBytes", config.maxBodyBytes, 1);
   r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);
+  r.size("referenceCacheBytes", config.referenceCacheBytes, 0);
   if (const Value* limits = r.object("limits")) readLimits(*limits, source, config.limits);
   r.finish();
   return config;

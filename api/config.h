@@ -21,6 +21,8 @@ struct ServiceConfig {
   int ioThreads = 1;    // threads running the HTTP connections
   size_t maxBodyBytes = 64u << 20;
   int requestTimeoutMs = 120000;
+  // Reference tessellations + BVHs kept for further requests with the same mesh and camera.
+  size_t referenceCacheBytes = 512u << 20;
   render::pipeline::JobLimits limits;
 };
 

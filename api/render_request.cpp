@@ -142,6 +142,7 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
   json::requireObject(params, "params");
   warnUnknownFields(params, "params",
                     {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample",
+                     "referenceCrossCheck",
                      "presubdivide", "searchSteps", "curveSamples", "contour"},
                     warnings);
   render::pipeline::MethodParams out;
@@ -173,6 +174,9 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
                          " is below limit minDicingRate (" +
                          json::formatNumber(limits.minDicingRate) + " pixels)");
     }
+  }
+  if (const Value* v = json::find(params, "referenceCrossCheck")) {
+    out.referenceCrossCheck = json::boolean(*v, "params.referenceCrossCheck");
   }
   if (const Value* v = json::find(params, "metricSupersample")) {
     out.metricSupersample = json::integer(*v, "params.metricSupersample");

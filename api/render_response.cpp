@@ -77,6 +77,10 @@ void writeMetrics(Writer& w, const render::metrics::Metrics& m) {
     numberField(w, "iou", m.silhouette->iou);
     w.Key("mismatchPx");
     w.Int64(m.silhouette->mismatchPx);
+    if (m.silhouette->outlineHausdorffPx) {
+      numberField(w, "outlineHausdorffPx", *m.silhouette->outlineHausdorffPx);
+      numberField(w, "outlineMeanPx", m.silhouette->outlineMeanPx.value_or(0.0));
+    }
     w.EndObject();
   }
   if (m.image) {
@@ -158,6 +162,26 @@ void writeStats(Writer& w, const render::pipeline::Stats& s) {
     numberField(w, "referenceCrossCheckMeanPx", s.referenceCrossCheckMeanPx.value_or(0.0));
   }
   if (s.silhouette) writeSilhouetteStats(w, *s.silhouette, s.presubdivided);
+  w.EndObject();
+}
+
+// referenceMs split by stage, with what the reference cast and whether its scene was cached.
+void writeReferenceStages(Writer& w, const render::oracle::ReferenceStats& s, double crossCheckMs) {
+  w.Key("referenceStages");
+  w.StartObject();
+  numberField(w, "tessellateMs", s.tessellateMs);
+  numberField(w, "bvhMs", s.bvhMs);
+  numberField(w, "primaryRaysMs", s.traceMs);
+  numberField(w, "newtonMs", s.newtonMs);
+  numberField(w, "maskMs", s.maskMs);
+  numberField(w, "outlineMs", s.outlineMs);
+  numberField(w, "crossCheckMs", crossCheckMs);
+  w.Key("sceneCached");
+  w.Bool(s.sceneCached);
+  w.Key("raysCast");
+  w.Uint64(s.raysCast);
+  w.Key("refinedPixels");
+  w.Uint64(s.refinedPixels);
   w.EndObject();
 }
 
@@ -244,6 +268,7 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
   numberField(w, "metricsMs", t.metricsMs);
   numberField(w, "encodeMs", encodeMs);
   numberField(w, "totalMs", t.parseMs + t.totalMs + encodeMs);
+  if (t.reference) writeReferenceStages(w, *t.reference, t.crossCheckMs);
   w.EndObject();
 
   w.Key("warnings");

@@ -156,6 +156,8 @@ int serve(const CommandLine& cl) {
   poolOptions.workers = config->workers;
   poolOptions.queueDepth = config->queueDepth;
   poolOptions.timeout = std::chrono::milliseconds(config->requestTimeoutMs);
+  render::oracle::ReferenceSceneCache referenceCache(config->referenceCacheBytes);
+  poolOptions.referenceCache = &referenceCache;
   server::WorkerPool pool(poolOptions);
   for (size_t i = 0; i < pool.workerStatus().size(); ++i) {
     const auto& w = pool.workerStatus()[i];

@@ -237,6 +237,25 @@ api::Answer Router::metrics() const {
       << "limn_render_jobs_refused_total{reason=\"busy\"} " << pool.rejectedBusy << "\n"
       << "limn_render_jobs_refused_total{reason=\"timeout\"} " << pool.timedOut << "\n"
       << "limn_render_jobs_refused_total{reason=\"shutdown\"} " << pool.cancelled << "\n";
+  if (const render::oracle::ReferenceSceneCache* cache = pool_.options().referenceCache) {
+    render::oracle::ReferenceSceneCache::Counters c = cache->counters();
+    out << "# HELP limn_reference_cache_lookups_total Reference scene lookups, by result.\n"
+           "# TYPE limn_reference_cache_lookups_total counter\n"
+        << "limn_reference_cache_lookups_total{result=\"hit\"} " << c.hits << "\n"
+        << "limn_reference_cache_lookups_total{result=\"miss\"} " << c.misses << "\n"
+        << "# HELP limn_reference_cache_evictions_total Reference scenes evicted to stay in bounds.\n"
+           "# TYPE limn_reference_cache_evictions_total counter\n"
+        << "limn_reference_cache_evictions_total " << c.evictions << "\n"
+        << "# HELP limn_reference_cache_entries Reference scenes held.\n"
+           "# TYPE limn_reference_cache_entries gauge\n"
+        << "limn_reference_cache_entries " << c.entries << "\n"
+        << "# HELP limn_reference_cache_bytes Estimated memory of the reference scenes held.\n"
+           "# TYPE limn_reference_cache_bytes gauge\n"
+        << "limn_reference_cache_bytes " << c.bytes << "\n"
+        << "# HELP limn_reference_cache_capacity_bytes Bound on limn_reference_cache_bytes.\n"
+           "# TYPE limn_reference_cache_capacity_bytes gauge\n"
+        << "limn_reference_cache_capacity_bytes " << c.capacityBytes << "\n";
+  }
 
   api::Answer answer;
   answer.status = 200;

@@ -126,6 +126,7 @@ WorkerPool::Reply WorkerPool::claimLocked(Job& job) {
 void WorkerPool::workerLoop(render::raster::Rasterizer& rasterizer) {
   render::pipeline::RenderContext context;
   context.rasterizer = &rasterizer;
+  context.referenceCache = options_.referenceCache;
   for (;;) {
     std::shared_ptr<Job> job;
     {

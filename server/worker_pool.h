@@ -37,6 +37,8 @@ struct PoolOptions {
   int workers = 0;                            // 0 = one per core
   size_t queueDepth = 64;                     // jobs waiting, not counting running ones
   std::chrono::milliseconds timeout{60'000};  // per job, from submission
+  // Shared by every worker's jobs (owned by the caller, outliving the pool); null: none.
+  render::oracle::ReferenceSceneCache* referenceCache = nullptr;
 };
 
 // What one worker thread reported when it tried to make its GL context.

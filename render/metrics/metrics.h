@@ -14,6 +14,9 @@ struct SilhouetteMetrics {
   double meanPx = 0;       // output pixels
   double iou = 1;          // at supersampled size
   long mismatchPx = 0;     // output pixels whose majority coverage differs
+  // Distances between the two outlines as curves in the image plane, output pixels, not
+  // quantised by the supersampling (outline.h); absent where no outline was located.
+  std::optional<double> outlineHausdorffPx, outlineMeanPx;
 };
 struct ColorMetrics {
   double rmse = 0, psnr = 0;

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <limits>
 
@@ -180,6 +181,91 @@ Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
           setRay(ray, pixelRay(camera, x + 0.5, y + 0.5));
           rtcOccluded1(scene, &context, &ray);
           if (ray.tfar < 0.0f) mask.at(x, y) = 1.0f;
+        }
+      }
+    }
+  });
+  return mask;
+}
+
+namespace {
+
+// Occlusion rays through up to 16 image-plane points of `camera` at once; bit k of the result is
+// set when ray k hit anything.
+uint32_t occludedLanes(RTCScene scene, const Camera& camera, const Vec2* points, int count,
+                       RTCIntersectContext& context) {
+  alignas(64) int valid[16];
+  alignas(64) RTCRay16 packet;
+  for (int k = 0; k < 16; ++k) {
+    valid[k] = k < count ? -1 : 0;
+    Vec2 p = points[k < count ? k : 0];
+    setLane(packet, k, pixelRay(camera, p.x, p.y));
+  }
+  rtcOccluded16(valid, scene, &context, &packet);
+  uint32_t hits = 0;
+  for (int k = 0; k < count; ++k) {
+    if (packet.tfar[k] < 0.0f) hits |= 1u << k;  // an occluded ray comes back with tfar = -inf
+  }
+  return hits;
+}
+
+}  // namespace
+
+void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
+                    std::vector<char>& covered, const CancelToken& cancel) {
+  covered.assign(points.size(), 0);
+  const size_t packets = (points.size() + 15) / 16;
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, packets, 64),
+                    [&](const tbb::blocked_range<size_t>& r) {
+    if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
+      cancelled = true;
+      return;
+    }
+    FlushDenormalsScope ftz;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (size_t p = r.begin(); p < r.end(); ++p) {
+      const size_t first = 16 * p;
+      const int count = static_cast<int>(std::min<size_t>(16, points.size() - first));
+      uint32_t hits = occludedLanes(scene, camera, points.data() + first, count, context);
+      for (int k = 0; k < count; ++k) covered[first + k] = (hits >> k) & 1;
+    }
+  });
+  if (cancelled) throw Cancelled();
+}
+
+Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
+                          const std::vector<char>& refine, const std::vector<char>& coarse,
+                          const CancelToken& cancel) {
+  const int width = camera.width(), height = camera.height(), s = supersample;
+  Image mask(width * s, height * s, 1, 0.0f);
+  forEachBand(height, cancel, [&](int y0, int y1) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    std::vector<Vec2> samples(static_cast<size_t>(s) * s);
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const size_t pixel = static_cast<size_t>(y) * width + x;
+        if (!refine[pixel]) {
+          if (!coarse[pixel]) continue;
+          for (int j = 0; j < s; ++j) {
+            std::fill_n(&mask.at(x * s, y * s + j), s, 1.0f);
+          }
+          continue;
+        }
+        // The block's sample centres, in output pixels, cast 16 at a time.
+        for (int j = 0; j < s; ++j) {
+          for (int i = 0; i < s; ++i) samples[j * s + i] = {x + (i + 0.5) / s, y + (j + 0.5) / s};
+        }
+        for (int first = 0; first < s * s; first += 16) {
+          int count = std::min(16, s * s - first);
+          uint32_t hits = occludedLanes(scene, camera, &samples[first], count, context);
+          for (int k = 0; k < count; ++k) {
+            int i = (first + k) % s, j = (first + k) / s;
+            if ((hits >> k) & 1) mask.at(x * s + i, y * s + j) = 1.0f;
+          }
         }
       }
     }

@@ -47,4 +47,18 @@ std::vector<PixelHit> castClosestHits(RTCScene scene, const Camera& camera, RayP
 Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
                    const CancelToken& cancel);
 
+// Coverage at arbitrary image-plane points of `camera` (output pixels, x right, y down): 1 where
+// the ray through the point hits anything. covered is resized to points.size(). All threads;
+// rays go 16 to a packet in the order given, so neighbouring points should come together.
+void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
+                    std::vector<char>& covered, const CancelToken& cancel);
+
+// The coverage mask at `supersample` times the camera's size, with rays only where they can
+// change it: output pixels marked in `refine` (row-major, width * height) get all S x S of their
+// samples cast; the others copy `coarse`'s value (1 covered / 0 not, per output pixel) into
+// their whole block.
+Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
+                          const std::vector<char>& refine, const std::vector<char>& coarse,
+                          const CancelToken& cancel);
+
 }  // namespace limn::render::oracle

@@ -12,6 +12,7 @@
 #include "render/core/shading.h"
 #include "render/oracle/ray_caster.h"
 #include "render/oracle/reference_tessellation.h"
+#include "render/oracle/reference_scene.h"
 #include "render/oracle/surface_hit.h"
 #include "render/oracle/triangle_scene.h"
 
@@ -69,103 +70,163 @@ struct PassImages {
   }
 };
 
-bool wantsPrimary(const PassSelection& p) {
-  return p.color || p.mask || p.depth || p.normal || p.wireframe;
+// Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
+// those with an 8-neighbour of other coverage, and those where the hint's block is mixed or
+// disagrees with the pixel.
+std::vector<char> pixelsToRefine(const std::vector<char>& covered, int width, int height,
+                                 const Image* hint, int s) {
+  std::vector<char> refine(covered.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y) {
+      for (int x = 0; x < width; ++x) {
+        const size_t p = static_cast<size_t>(y) * width + x;
+        bool differs = false;
+        for (int dy = -1; dy <= 1 && !differs; ++dy) {
+          for (int dx = -1; dx <= 1 && !differs; ++dx) {
+            int nx = x + dx, ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+            differs = covered[static_cast<size_t>(ny) * width + nx] != covered[p];
+          }
+        }
+        if (!differs && hint) {
+          for (int j = 0; j < s && !differs; ++j) {
+            for (int i = 0; i < s && !differs; ++i) {
+              differs = (hint->at(x * s + i, y * s + j) > 0.5f) != (covered[p] != 0);
+            }
+          }
+        }
+        refine[p] = differs;
+      }
+    }
+  });
+  return refine;
+}
+
+metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,
+                                     const CancelToken& cancel) {
+  return [scene, &camera, &cancel](const std::vector<Vec2>& points, std::vector<char>& covered) {
+    castCoverageAt(scene, camera, points, covered, cancel);
+  };
 }
 
 }  // namespace
 
 ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
-                                const PassSelection& passes, const CancelToken& cancel) {
+                                const PassSelection& passes, const CancelToken& cancel,
+                                const ReferenceOptions& options) {
   ReferenceResult result;
   ReferenceStats& stats = result.stats;
 
-  auto start = Clock::now();
-  ReferenceTessellation tessellation = tessellateForReference(surface, camera, cancel);
+  std::shared_ptr<const ReferenceScene> built;
+  if (options.cache) {
+    built = options.cache->get(surface, camera, cancel, &stats.sceneCached);
+  } else {
+    built = buildReferenceScene(surface, camera, cancel);
+  }
+  const ReferenceTessellation& tessellation = built->tessellation;
   const tessellate::TriangleMesh& mesh = tessellation.mesh;
+  RTCScene scene = built->scene.get();
   stats.triangles = mesh.triangleCount();
   stats.outlineFaces = tessellation.outlineFaces;
   stats.outlineErrorPx = tessellation.outlineErrorPx;
+  if (!stats.sceneCached) {
+    stats.tessellateMs = built->tessellateMs;
+    stats.bvhMs = built->bvhMs;
+  }
   if (tessellation.outlineErrorPx > kOutlineChordErrorPx * 1.0001) {
     result.warnings.push_back(
         "reference: outline chord error raised to " + std::to_string(tessellation.outlineErrorPx) +
         " px (from " + std::to_string(kOutlineChordErrorPx) + ") to stay within " +
         std::to_string(static_cast<long>(kReferenceTriangleBudget)) + " triangles");
   }
-  stats.tessellateMs = msSince(start);
   cancel.check();
+
+  // Primary rays at pixel centres: the passes, and the coverage the supersampled mask starts from.
+  const int width = camera.width(), height = camera.height();
+  auto start = Clock::now();
+  std::vector<PixelHit> hits = castClosestHits(scene, camera, RayPacking::Packet16, cancel);
+  stats.traceMs = msSince(start);
+  stats.raysCast += hits.size();
 
   start = Clock::now();
-  // Build quality: see triangle_scene.h for the measurements behind this choice.
-  EmbreeScene scene = buildTriangleScene(
-      mesh, passes.supersample > 0 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW);
-  stats.bvhMs = msSince(start);
-  cancel.check();
-
-  if (wantsPrimary(passes)) {
-    const int width = camera.width(), height = camera.height();
-    start = Clock::now();
-    std::vector<PixelHit> hits = castClosestHits(scene.get(), camera, RayPacking::Packet16, cancel);
-    stats.traceMs = msSince(start);
-    stats.raysCast += hits.size();
-
-    start = Clock::now();
-    PassImages images(result.images, passes, width, height);
-    const double tolerance = kRelativeTolerance * std::max(surface.bounds().diagonal(), 1e-300);
-    std::atomic<size_t> covered{0}, failures{0};
-    std::atomic<bool> cancelled{false};
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
-      if (cancelled || cancel.expired()) {
-        cancelled = true;
-        return;
-      }
-      size_t rowCovered = 0, rowFailures = 0;
-      for (int y = r.begin(); y < r.end(); ++y) {
-        for (int x = 0; x < width; ++x) {
-          const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
-          if (!h.hit()) continue;
-          PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
-          int face;
-          Vec2 uv;
-          SurfaceHit hit = triangleHitUV(surface, mesh, h.primID, h.u, h.v, &face, &uv)
-                               ? refineHit(surface, face, uv, ray, h.t, tolerance)
-                               : unrefinedHit(surface, face, uv, ray, h.t);
-          ++rowCovered;
-          rowFailures += !hit.refined;
-          images.write(x, y, hit, camera);
-        }
-      }
-      covered += rowCovered;
-      failures += rowFailures;
-    });
-    if (cancelled) throw Cancelled();
-    stats.hits = covered;
-    stats.newtonFailures = failures;
-    stats.newtonMs = msSince(start);
-    if (passes.wireframe) {
-      result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
-      if (!passes.color) result.images.passes.erase(pass::kColor);
-      result.warnings.push_back(
-          "reference wireframe: the limit surface has no edges; the pass is the shaded color");
+  PassImages images(result.images, passes, width, height);
+  const double tolerance = kRelativeTolerance * std::max(surface.bounds().diagonal(), 1e-300);
+  std::atomic<size_t> covered{0}, failures{0};
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
+    if (cancelled || cancel.expired()) {
+      cancelled = true;
+      return;
     }
-    if (stats.hits > 0 && stats.newtonFailures * 1000 > stats.hits) {
-      result.warnings.push_back("reference: " + std::to_string(stats.newtonFailures) + " of " +
-                                std::to_string(stats.hits) +
-                                " hits could not be refined onto the limit surface (kept on the "
-                                "dense tessellation)");
+    size_t rowCovered = 0, rowFailures = 0;
+    for (int y = r.begin(); y < r.end(); ++y) {
+      for (int x = 0; x < width; ++x) {
+        const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
+        if (!h.hit()) continue;
+        PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
+        int face;
+        Vec2 uv;
+        SurfaceHit hit = triangleHitUV(surface, mesh, h.primID, h.u, h.v, &face, &uv)
+                             ? refineHit(surface, face, uv, ray, h.t, tolerance)
+                             : unrefinedHit(surface, face, uv, ray, h.t);
+        ++rowCovered;
+        rowFailures += !hit.refined;
+        images.write(x, y, hit, camera);
+      }
     }
+    covered += rowCovered;
+    failures += rowFailures;
+  });
+  if (cancelled) throw Cancelled();
+  stats.hits = covered;
+  stats.newtonFailures = failures;
+  stats.newtonMs = msSince(start);
+  if (passes.wireframe) {
+    result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
+    if (!passes.color) result.images.passes.erase(pass::kColor);
+    result.warnings.push_back(
+        "reference wireframe: the limit surface has no edges; the pass is the shaded color");
+  }
+  if (stats.hits > 0 && stats.newtonFailures * 1000 > stats.hits) {
+    result.warnings.push_back("reference: " + std::to_string(stats.newtonFailures) + " of " +
+                              std::to_string(stats.hits) +
+                              " hits could not be refined onto the limit surface (kept on the "
+                              "dense tessellation)");
   }
 
   if (passes.supersample > 0) {
+    const int s = passes.supersample;
     start = Clock::now();
-    Camera fine = camera.scaled(passes.supersample);
-    result.images.supersampledMask =
-        castCoverage(scene.get(), fine, RayPacking::Packet16, cancel);
-    result.images.supersample = passes.supersample;
-    stats.raysCast += static_cast<size_t>(fine.width()) * fine.height();
+    std::vector<char> coverage(hits.size());
+    for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
+    const Image* hint = options.maskHint;
+    if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
+      hint = nullptr;
+    }
+    std::vector<char> refine = pixelsToRefine(coverage, width, height, hint, s);
+    for (char r : refine) stats.refinedPixels += r != 0;
+    result.images.supersampledMask = castCoverageRefined(scene, camera, s, refine, coverage, cancel);
+    result.images.supersample = s;
+    stats.raysCast += stats.refinedPixels * s * s;
     stats.maskMs = msSince(start);
+
+    if (options.locateOutline) {
+      start = Clock::now();
+      result.outline = metrics::locateOutline(result.images.supersampledMask, s,
+                                              coverageQuery(scene, camera, cancel), cancel);
+      stats.outlineMs = msSince(start);
+    }
   }
   return result;
+}
+
+metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,
+                                   const Image& supersampledMask, int supersample,
+                                   const CancelToken& cancel) {
+  EmbreeScene scene = buildTriangleScene(mesh, RTC_BUILD_QUALITY_LOW);
+  cancel.check();
+  return metrics::locateOutline(supersampledMask, supersample,
+                                coverageQuery(scene.get(), camera, cancel), cancel);
 }
 
 }  // namespace limn::render::oracle

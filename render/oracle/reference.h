@@ -5,8 +5,10 @@
 // so the outline's chord error is about 0.01 output pixels: reference_tessellation.h); every hit
 // is then moved onto the true surface at its (face, u, v) by Newton steps on the Bfr surface,
 // so depth and normals are exact to about 1e-9 of the model size (surface_hit.h). Shading uses
-// the limit normal and render/core/shading.h. For Catmull-Clark meshes a second, independent
-// path ray-casts Embree's own subdivision geometry, and the two masks' disagreement is reported.
+// the limit normal and render/core/shading.h. The tessellation and its BVH can be kept in a
+// ReferenceSceneCache for the next request with the same mesh and camera. For Catmull-Clark
+// meshes a second, independent path ray-casts Embree's own subdivision geometry (on request:
+// it costs about as much as the reference), and the two masks' disagreement is reported.
 #pragma once
 
 #include <optional>
@@ -17,6 +19,8 @@
 #include "render/core/cancel.h"
 #include "render/core/image.h"
 #include "render/core/passes.h"
+#include "render/metrics/outline.h"
+#include "render/oracle/reference_scene.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::oracle {
@@ -25,18 +29,31 @@ struct ReferenceStats {
   size_t triangles = 0;        // of the dense tessellation
   size_t raysCast = 0;
   size_t newtonFailures = 0;   // hits whose refinement did not converge (kept unrefined)
-  double tessellateMs = 0, bvhMs = 0, traceMs = 0;
+  double tessellateMs = 0, bvhMs = 0, traceMs = 0;  // 0 for the first two on a cache hit
   size_t outlineFaces = 0;     // faces tessellated finely because they carry an outline
   double outlineErrorPx = 0;   // chord error aimed for at the outline, output pixels
   size_t hits = 0;             // output pixels covered
   double newtonMs = 0;         // refinement and shading of the hits (traceMs: primary rays only)
   double maskMs = 0;           // the supersampled mask's rays
+  double outlineMs = 0;        // locating the outline to sub-pixel precision
+  size_t refinedPixels = 0;    // output pixels whose S x S samples were all cast
+  bool sceneCached = false;    // the tessellation and BVH came from the cache
 };
 
 struct ReferenceResult {
   ImageSet images;
+  metrics::Outline outline;  // when asked for (ReferenceOptions::locateOutline)
   ReferenceStats stats;
   std::vector<std::string> warnings;
+};
+
+struct ReferenceOptions {
+  // A mask at S times the output size (the approximation's): output pixels where its S x S
+  // block is not uniform, or disagrees with the reference's own pixel, get all their samples
+  // cast too, so the reference's mask is exact wherever either side has an outline.
+  const Image* maskHint = nullptr;
+  bool locateOutline = false;           // needs passes.supersample > 0
+  ReferenceSceneCache* cache = nullptr;  // where to find and keep the tessellation and BVH
 };
 
 // `passes.supersample` > 0 also fills the supersampled mask. Uses all hardware threads through
@@ -47,9 +64,24 @@ struct ReferenceResult {
 // limit normal as oriented by the face winding (not flipped towards the viewer; 0 = empty).
 // The wireframe pass of the reference is its color pass: the limit surface has no edges to draw
 // (a warning says so). Rays are clipped to the camera's [near, far] like the rasteriser's
-// triangles. The supersampled mask is the dense tessellation's coverage at camera.scaled(S).
+// triangles.
+//
+// The supersampled mask is the dense tessellation's coverage at camera.scaled(S), cast where it
+// can differ from the output pixel's own coverage: in every output pixel that has an 8-neighbour
+// of other coverage (an outline crossing a pixel's square always leaves some 8-neighbour's
+// centre on its other side, unless it is a loop or sliver narrower than a pixel), and where the
+// hint says so; elsewhere the pixel's coverage fills its block. A feature thinner than a pixel
+// that falls between pixel centres, and that the hint lacks too, is missed (docs/engine.md).
 ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
-                                const PassSelection& passes, const CancelToken& cancel);
+                                const PassSelection& passes, const CancelToken& cancel,
+                                const ReferenceOptions& options = {});
+
+// The outline of any triangle mesh (an approximation) seen by `camera`, located to sub-pixel
+// precision by rays against its own triangles; `supersampledMask` (its coverage at S times the
+// size, e.g. from the rasteriser) says where to look.
+metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,
+                                   const Image& supersampledMask, int supersample,
+                                   const CancelToken& cancel);
 
 // The independent check (Catmull-Clark only): Embree's RTC_GEOMETRY_TYPE_SUBDIVISION with the
 // mesh's creases and corners, cast at `camera` (pass the supersampled one); returns its coverage

@@ -14,6 +14,7 @@
 #include "render/core/image.h"
 #include "render/core/passes.h"
 #include "render/mesh/control_mesh.h"
+#include "render/oracle/reference.h"
 #include "render/metrics/metrics.h"
 #include "render/silhouette/presubdivide.h"
 #include "render/silhouette/silhouette_mesh.h"
@@ -36,6 +37,9 @@ struct MethodParams {
   bool pushToLimit = false;     // uniform: move every refined vertex to its limit position
   double dicingRate = 1.0;      // adaptive: target edge length in pixels
   int metricSupersample = 4;    // S for the silhouette metrics
+  // Also ray-cast Embree's own subdivision geometry and report its agreement with the reference
+  // (Catmull-Clark only; costs about as much as the reference itself).
+  bool referenceCrossCheck = false;
   // silhouette
   silhouette::Presubdivide presubdivide = silhouette::Presubdivide::Auto;
   int searchSteps = 5;          // bisection steps of the edge search
@@ -89,6 +93,9 @@ struct Stats {
 struct Timings {
   double parseMs = 0, surfaceMs = 0, approxMs = 0, rasterMs = 0, referenceMs = 0,
          metricsMs = 0, totalMs = 0;
+  // referenceMs split by stage (when a reference was made); crossCheckMs is part of referenceMs.
+  std::optional<oracle::ReferenceStats> reference;
+  double crossCheckMs = 0;
 };
 
 struct RenderResult {
@@ -104,6 +111,8 @@ struct RenderResult {
 // Per-thread resources a job runs with (each worker owns one).
 struct RenderContext {
   raster::Rasterizer* rasterizer = nullptr;
+  // Shared by all workers; null: every reference builds its own scene.
+  oracle::ReferenceSceneCache* referenceCache = nullptr;
 };
 
 // Runs the job. Throws InputError for what the request got wrong and Cancelled when `cancel`

@@ -1,4 +1,5 @@
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "render/core/error.h"
@@ -143,6 +144,34 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   return selected;
 }
 
+// The independent check (Catmull-Clark): Embree's own subdivision geometry against the
+// reference's supersampled mask; the agreement goes into stats, a disagreement over a pixel or a
+// reason it could not run into the warnings.
+void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& camera, int S,
+                         const Image& referenceMask, const CancelToken& cancel,
+                         RenderResult& result) {
+  if (surface.mesh().scheme != mesh::Scheme::CatmullClark) {
+    result.warnings.push_back("reference cross-check skipped: Embree's subdivision geometry is "
+                              "Catmull-Clark only");
+    return;
+  }
+  std::string whyNot;
+  std::optional<Image> embreeMask =
+      oracle::embreeSubdivisionMask(surface, camera.scaled(S), cancel, &whyNot);
+  if (!embreeMask) {
+    result.warnings.push_back("reference cross-check skipped: " + whyNot);
+    return;
+  }
+  metrics::SilhouetteMetrics agreement = metrics::compareSilhouettes(*embreeMask, referenceMask, S);
+  result.stats.referenceCrossCheckPx = agreement.hausdorffPx;
+  result.stats.referenceCrossCheckMeanPx = agreement.meanPx;
+  if (agreement.hausdorffPx > 1.0) {
+    result.warnings.push_back("the two reference paths disagree: Embree's subdivision geometry is " +
+                              std::to_string(agreement.hausdorffPx) +
+                              " px from the tessellated reference");
+  }
+}
+
 }  // namespace
 
 const char* methodName(Method method) {
@@ -219,27 +248,19 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   if (needReference) {
     PassSelection passes{.color = true, .mask = true, .depth = true, .normal = true,
                          .supersample = measure ? S : 0};
-    oracle::ReferenceResult reference = oracle::renderReference(surface, camera, passes, cancel);
+    oracle::ReferenceOptions options{.maskHint = approx ? &result.images.supersampledMask : nullptr,
+                                     .locateOutline = measure,
+                                     .cache = context.referenceCache};
+    oracle::ReferenceResult reference =
+        oracle::renderReference(surface, camera, passes, cancel, options);
     result.stats.referenceTriangles = reference.stats.triangles;
     result.warnings.insert(result.warnings.end(), reference.warnings.begin(),
                            reference.warnings.end());
-    if (measure && job.mesh.scheme == mesh::Scheme::CatmullClark) {
-      std::string whyNot;
-      std::optional<Image> embreeMask =
-          oracle::embreeSubdivisionMask(surface, camera.scaled(S), cancel, &whyNot);
-      if (embreeMask) {
-        metrics::SilhouetteMetrics agreement =
-            metrics::compareSilhouettes(*embreeMask, reference.images.supersampledMask, S);
-        result.stats.referenceCrossCheckPx = agreement.hausdorffPx;
-        result.stats.referenceCrossCheckMeanPx = agreement.meanPx;
-        if (agreement.hausdorffPx > 1.0) {
-          result.warnings.push_back(
-              "the two reference paths disagree: Embree's subdivision geometry is " +
-              std::to_string(agreement.hausdorffPx) + " px from the tessellated reference");
-        }
-      } else {
-        result.warnings.push_back("reference cross-check skipped: " + whyNot);
-      }
+    result.timings.reference = reference.stats;
+    if (measure && job.params.referenceCrossCheck) {
+      Stopwatch crossCheck;
+      crossCheckReference(surface, camera, S, reference.images.supersampledMask, cancel, result);
+      result.timings.crossCheckMs = crossCheck.lapMs();
     }
     result.timings.referenceMs = clock.lapMs();
     cancel.check();
@@ -249,6 +270,12 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       const ImageSet& refImages = reference.images;
       result.metrics.silhouette = metrics::compareSilhouettes(
           approxImages.supersampledMask, refImages.supersampledMask, S);
+      metrics::Outline outline =
+          oracle::locateMeshOutline(*approx, camera, approxImages.supersampledMask, S, cancel);
+      metrics::OutlineDistances d = metrics::compareOutlines(
+          outline, reference.outline, std::hypot(camera.width(), camera.height()));
+      result.metrics.silhouette->outlineHausdorffPx = d.hausdorffPx;
+      result.metrics.silhouette->outlineMeanPx = d.meanPx;
       result.metrics.image = metrics::compareColor(approxImages, refImages);
       result.metrics.depth =
           metrics::compareDepth(approxImages, refImages, surface.bounds().diagonal());

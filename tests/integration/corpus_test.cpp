@@ -172,7 +172,8 @@ std::string obliqueCamera(const std::string& obj, int size) {
 
 std::unique_ptr<Rendered> render(const std::string& obj, const std::string& scheme,
                                  const std::string& method, int size, bool reference,
-                                 int level = 0, const std::string& extraOutputs = "") {
+                                 int level = 0, const std::string& extraOutputs = "",
+                                 bool crossCheck = false) {
   std::ostringstream request;
   rapidjson::StringBuffer data;
   {
@@ -181,7 +182,9 @@ std::unique_ptr<Rendered> render(const std::string& obj, const std::string& sche
   }
   request << R"({"mesh":{"format":"obj","scheme":")" << scheme << R"(","data":)" << data.GetString()
           << R"(},"camera":)" << obliqueCamera(obj, size) << R"(,"method":")"
-          << method << R"(","params":{"level":)" << level << R"(,"dicingRate":1},"outputs":["color")"
+          << method << R"(","params":{"level":)" << level
+          << R"(,"dicingRate":1,"referenceCrossCheck":)" << (crossCheck ? "true" : "false")
+          << R"(},"outputs":["color")"
           << extraOutputs << R"(],"reference":)" << (reference ? "true" : "false") << "}";
   HttpResponse response = post(CorpusServer::server->port(), "/v1/render", request.str());
   auto out = std::make_unique<Rendered>();
@@ -255,11 +258,18 @@ TEST_P(EveryShape, EveryMethodAnswers) {
 TEST_P(EveryShape, ErrorsAgainstTheReference) {
   const Shape& shape = GetParam();
   if (shape.scheme == "bilinear") GTEST_SKIP() << "bilinear surfaces are their own cage";
-  auto adaptive = render(shape.obj, shape.scheme, "adaptive", 1024, true);
+  auto adaptive = render(shape.obj, shape.scheme, "adaptive", 1024, true, 0, "", true);
   if (adaptive->status == 422) GTEST_SKIP() << "OpenSubdiv does not accept this mesh";
   ASSERT_EQ(adaptive->status, 200);
   double adaptivePx = hausdorff(*adaptive);
   EXPECT_LE(adaptivePx, 1.0) << shape.name;
+  // The continuous outline distance sees what the quantised mask metric sees, and no more than
+  // a supersampled pixel beyond it.
+  const rapidjson::Value& silhouette = adaptive->body["metrics"]["silhouette"];
+  ASSERT_TRUE(silhouette.HasMember("outlineHausdorffPx")) << shape.name;
+  EXPECT_LE(silhouette["outlineHausdorffPx"].GetDouble(), adaptivePx + 0.25) << shape.name;
+  EXPECT_LE(silhouette["outlineMeanPx"].GetDouble(), silhouette["meanPx"].GetDouble() + 0.25)
+      << shape.name;
   RecordProperty("adaptiveHausdorffPx", std::to_string(adaptivePx));
   // The two reference paths agree to one supersampled pixel (the finest step a mask
   // Hausdorff distance has: 0.25 px at S = 4) and on average to a hundredth of a pixel.

@@ -145,6 +145,41 @@ TEST_F(ServerTest, RenderOfACubeAnswersAPng) {
   EXPECT_EQ(doc["stats"]["controlFaces"].GetInt(), 6);
 }
 
+// A second request for the same mesh and view (another method) takes the reference's
+// tessellation and BVH from the cache, says so, measures the same continuous outline distance
+// for the same approximation, and /metrics counts the hit.
+TEST_F(ServerTest, SecondReferenceForTheSameViewComesFromTheCache) {
+  const std::string camera = R"(, "camera": {"width": 160, "height": 160, "eye": [2.1, 1.7, 3.3]})";
+  auto body = [&](const char* method) {
+    return std::string(R"({"mesh": {"format": "obj", "data": ")") + kCubeObj + R"("})" + camera +
+           R"(, "method": ")" + method + R"(", "reference": true, "outputs": ["color"]})";
+  };
+  HttpResponse first = post(port(), "/v1/render", body("coarse"));
+  HttpResponse second = post(port(), "/v1/render", body("uniform"));
+  HttpResponse third = post(port(), "/v1/render", body("coarse"));
+  ASSERT_EQ(first.status, 200) << first.body.substr(0, 300);
+  ASSERT_EQ(second.status, 200) << second.body.substr(0, 300);
+  ASSERT_EQ(third.status, 200) << third.body.substr(0, 300);
+  auto a = parseJson(first.body), b = parseJson(second.body), c = parseJson(third.body);
+  EXPECT_FALSE(a["timings"]["referenceStages"]["sceneCached"].GetBool());
+  EXPECT_TRUE(b["timings"]["referenceStages"]["sceneCached"].GetBool());
+  EXPECT_TRUE(c["timings"]["referenceStages"]["sceneCached"].GetBool());
+  // The cage of a cube is far from its limit surface; level 3 is close: the continuous metric
+  // ranks them, and is the same number for the same approximation, cached or not.
+  double coarsePx = a["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble();
+  double uniformPx = b["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble();
+  EXPECT_GT(coarsePx, 5.0);
+  EXPECT_LT(uniformPx, coarsePx / 4);
+  EXPECT_DOUBLE_EQ(c["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble(), coarsePx);
+  EXPECT_FALSE(a["stats"].HasMember("referenceCrossCheckPx"));  // only when asked for
+
+  HttpResponse metrics = get(port(), "/metrics");
+  EXPECT_NE(metrics.body.find("limn_reference_cache_lookups_total{result=\"hit\"}"),
+            std::string::npos);
+  EXPECT_EQ(metrics.body.find("limn_reference_cache_lookups_total{result=\"hit\"} 0\n"),
+            std::string::npos);
+}
+
 // The silhouette method through the server: exact outline on the cube, its counts, the
 // contour overlay as an extra image, and normal-map shading.
 TEST_F(ServerTest, SilhouetteMethodAnswersWithItsStatsAndOverlay) {

@@ -863,7 +863,7 @@ render::pipeline::RenderResult handMadeResult() {
   reference.passes[render::pass::kMask] = render::Image(4, 3, 1, 1.0f);
 
   render::metrics::Metrics metrics;
-  metrics.silhouette = render::metrics::SilhouetteMetrics{0.31, 0.05, 0.9991, 212};
+  metrics.silhouette = render::metrics::SilhouetteMetrics{0.31, 0.05, 0.9991, 212, 0.087, 0.012};
   metrics.image = render::metrics::ColorMetrics{0.004, std::numeric_limits<double>::infinity()};
   metrics.geometry = render::metrics::GeometryMetrics{0.0002, std::nan(""), 0.00004};
 
@@ -874,7 +874,10 @@ render::pipeline::RenderResult handMadeResult() {
   stats.vertices = 24002;
   stats.referenceTriangles = 1u << 20;
   stats.referenceCrossCheckPx = 0.125;
-  render::pipeline::Timings timings{0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 20.0};
+  render::pipeline::Timings timings{0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 20.0, std::nullopt, 0.0};
+  timings.reference = render::oracle::ReferenceStats{};
+  timings.reference->sceneCached = true;
+  timings.reference->newtonMs = 1.5;
   return {images, reference, metrics, stats, timings, {"engine note"}, camera};
 }
 
@@ -915,6 +918,8 @@ TEST(RenderResponse, HasTheDesignShape) {
   EXPECT_DOUBLE_EQ(m["silhouette"]["meanPx"].GetDouble(), 0.05);
   EXPECT_DOUBLE_EQ(m["silhouette"]["iou"].GetDouble(), 0.9991);
   EXPECT_EQ(m["silhouette"]["mismatchPx"].GetInt(), 212);
+  EXPECT_DOUBLE_EQ(m["silhouette"]["outlineHausdorffPx"].GetDouble(), 0.087);
+  EXPECT_DOUBLE_EQ(m["silhouette"]["outlineMeanPx"].GetDouble(), 0.012);
   EXPECT_DOUBLE_EQ(m["image"]["rmse"].GetDouble(), 0.004);
   EXPECT_TRUE(m["image"]["psnr"].IsNull());  // infinity is not JSON
   EXPECT_TRUE(m["geometry"]["meanDist"].IsNull());
@@ -941,6 +946,9 @@ TEST(RenderResponse, HasTheDesignShape) {
   double encodeMs = t["encodeMs"].GetDouble();
   EXPECT_GE(encodeMs, 0.0);
   EXPECT_NEAR(t["totalMs"].GetDouble(), 0.5 + 20.0 + encodeMs, 1e-9);
+  ASSERT_TRUE(t.HasMember("referenceStages"));
+  EXPECT_TRUE(t["referenceStages"]["sceneCached"].GetBool());
+  EXPECT_DOUBLE_EQ(t["referenceStages"]["newtonMs"].GetDouble(), 1.5);
 
   const rapidjson::Value& w = doc["warnings"];
   ASSERT_EQ(w.Size(), 2u);

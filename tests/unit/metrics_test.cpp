@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <numbers>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "render/metrics/metrics.h"
+#include "render/metrics/outline.h"
 #include "render/subdiv/limit_surface.h"
 #include "tests/unit/test_meshes.h"
 
@@ -579,6 +582,114 @@ TEST(Geometry, MeshWithoutLimitInformationIsRejected) {
   EXPECT_THROW(measureGeometry(mesh, surface), std::invalid_argument);
   // An empty mesh measures nothing.
   EXPECT_EQ(measureGeometry(tessellate::TriangleMesh{}, surface).maxDist, 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Continuous outline distances (outline.h): analytic shapes, with the coverage query answering
+// exactly where the shape is, and masks sampled from the same shapes.
+
+using Shape = std::function<bool(double x, double y)>;
+
+Image sampleMask(const Shape& inside, int size, int s) {
+  Image mask(size * s, size * s, 1);
+  for (int j = 0; j < size * s; ++j) {
+    for (int i = 0; i < size * s; ++i) mask.at(i, j) = inside((i + 0.5) / s, (j + 0.5) / s);
+  }
+  return mask;
+}
+
+CoverageQuery queryOf(const Shape& inside) {
+  return [inside](const std::vector<Vec2>& points, std::vector<char>& covered) {
+    covered.resize(points.size());
+    for (size_t k = 0; k < points.size(); ++k) covered[k] = inside(points[k].x, points[k].y);
+  };
+}
+
+Outline outlineOf(const Shape& inside, int size, int s) {
+  return locateOutline(sampleMask(inside, size, s), s, queryOf(inside), CancelToken{});
+}
+
+Shape discAt(double cx, double cy, double r) {
+  return [=](double x, double y) { return (x - cx) * (x - cx) + (y - cy) * (y - cy) < r * r; };
+}
+
+TEST(Outline, PointsLieOnTheCurveToTheTolerance) {
+  const double cx = 40.3, cy = 37.8, r = 21.7;
+  Outline o = outlineOf(discAt(cx, cy, r), 80, 4);
+  ASSERT_GT(o.points.size(), 500u);
+  for (Vec2 p : o.points) EXPECT_NEAR(std::hypot(p.x - cx, p.y - cy), r, kOutlineTolerancePx);
+  // A closed curve: every crossing joins two segments.
+  std::vector<int> degree(o.points.size(), 0);
+  for (auto [a, b] : o.segments) ++degree[a], ++degree[b];
+  for (int d : degree) EXPECT_EQ(d, 2);
+}
+
+TEST(Outline, DiscShiftedByThreeTenthsOfAPixel) {
+  for (int s : {1, 4, 8}) {
+    Outline a = outlineOf(discAt(50.2, 49.6, 30.0), 100, s);
+    Outline b = outlineOf(discAt(50.5, 49.6, 30.0), 100, s);
+    OutlineDistances d = compareOutlines(a, b, 141.0);
+    EXPECT_NEAR(d.hausdorffPx, 0.3, 0.01) << "S = " << s;
+    // The mean of |0.3 cos(theta)| around the circle is 0.6 / pi.
+    EXPECT_NEAR(d.meanPx, 0.6 / std::numbers::pi, 0.01) << "S = " << s;
+  }
+}
+
+TEST(Outline, SquareAgainstItselfIsZero) {
+  Shape square = [](double x, double y) { return x > 10.37 && x < 52.81 && y > 12.02 && y < 49.5; };
+  Outline a = outlineOf(square, 64, 4);
+  ASSERT_FALSE(a.empty());
+  OutlineDistances d = compareOutlines(a, a, 90.0);
+  EXPECT_EQ(d.hausdorffPx, 0.0);
+  EXPECT_EQ(d.meanPx, 0.0);
+  // Located from a mask at another supersampling, the same square agrees along its sides to the
+  // tolerance; at its corners the polyline may cut the corner by a sixth of a cell at most.
+  OutlineDistances d8 = compareOutlines(a, outlineOf(square, 64, 8), 90.0);
+  EXPECT_LT(d8.hausdorffPx, 0.25 / 6);
+  EXPECT_LT(d8.meanPx, 2 * kOutlineTolerancePx);
+}
+
+TEST(Outline, SubQuantumShiftsAreSeenWhereMaskMetricsReadZero) {
+  // 0.05 px is below a supersampled pixel at S = 4: the mask metric cannot tell, this can.
+  Shape a = discAt(32.0, 32.0, 20.0), b = discAt(32.05, 32.0, 20.0);
+  OutlineDistances d = compareOutlines(outlineOf(a, 64, 4), outlineOf(b, 64, 4), 90.0);
+  EXPECT_NEAR(d.hausdorffPx, 0.05, 0.005);
+}
+
+TEST(Outline, OneSidedOutlineIsFarAndBothEmptyIsZero) {
+  Outline none = outlineOf([](double, double) { return false; }, 32, 4);
+  Outline full = outlineOf([](double, double) { return true; }, 32, 4);
+  EXPECT_TRUE(none.empty());
+  EXPECT_TRUE(full.empty());  // the image frame is not an outline
+  Outline disc = outlineOf(discAt(16, 16, 8), 32, 4);
+  EXPECT_EQ(compareOutlines(none, full, 45.0).hausdorffPx, 0.0);
+  EXPECT_EQ(compareOutlines(disc, none, 45.0).hausdorffPx, 45.0);
+  EXPECT_EQ(compareOutlines(none, disc, 45.0).meanPx, 45.0);
+}
+
+TEST(Outline, MissingPieceIsItsDistanceAway) {
+  // Two discs against one of them: the second disc's outline is as far from the first's as the
+  // gap between the two circles.
+  Shape one = discAt(20, 32, 10), two = [](double x, double y) {
+    return discAt(20, 32, 10)(x, y) || discAt(50, 32, 6)(x, y);
+  };
+  OutlineDistances d = compareOutlines(outlineOf(one, 64, 4), outlineOf(two, 64, 4), 90.0);
+  EXPECT_NEAR(d.hausdorffPx, 50 + 6 - 30, 0.01);  // the far side of the second disc
+}
+
+TEST(Outline, SaddleCellsFollowTheQuery) {
+  // A checkerboard of 1 px squares seen at S = 1: every cell is a saddle, resolved by the query
+  // at its centre; every crossing still ends up joined.
+  Shape board = [](double x, double y) {
+    return (static_cast<int>(std::floor(x)) + static_cast<int>(std::floor(y))) % 2 == 0;
+  };
+  Outline o = outlineOf(board, 16, 1);
+  ASSERT_FALSE(o.empty());
+  for (Vec2 p : o.points) {
+    double fx = p.x - std::floor(p.x), fy = p.y - std::floor(p.y);
+    EXPECT_TRUE(std::min(fx, 1 - fx) < 2e-3 || std::min(fy, 1 - fy) < 2e-3);
+  }
+  EXPECT_GE(o.segments.size(), o.points.size() - 64);
 }
 
 }  // namespace

@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cmath>
+#include <iterator>
 #include <numbers>
+#include <vector>
 
 #include "render/mesh/control_mesh.h"
 
@@ -111,6 +113,90 @@ inline ControlMesh torus(int ring = 12, int tube = 8, bool creases = true) {
     for (int i = 0; i < ring; ++i) m.creases.push_back({id(i, 0), id(i + 1, 0), 10.0f});
     for (int j = 0; j < tube; ++j) m.creases.push_back({id(0, j), id(0, j + 1), 2.0f});
   }
+  return m;
+}
+
+
+// Merges coincident points (within 1e-9) and renumbers the faces: for meshes made of patches
+// whose shared borders were generated twice.
+inline ControlMesh weldPoints(ControlMesh m) {
+  std::vector<int> remap(m.points.size());
+  std::vector<Vec3> kept;
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    int found = -1;
+    for (size_t j = 0; j < kept.size() && found < 0; ++j) {
+      Vec3 d = kept[j] - m.points[i];
+      if (d.x * d.x + d.y * d.y + d.z * d.z < 1e-18) found = static_cast<int>(j);
+    }
+    if (found < 0) {
+      found = static_cast<int>(kept.size());
+      kept.push_back(m.points[i]);
+    }
+    remap[i] = found;
+  }
+  for (int& v : m.faceVertexIndices) v = remap[v];
+  m.points = std::move(kept);
+  return m;
+}
+
+// A bumpy ball: a cube whose faces are split into n x n quads, pushed onto a sphere and
+// displaced by a few low-frequency bumps. 6 n^2 faces (n = 16: 1,536), eight valence-3 vertices,
+// the rest regular: a dense closed model with inner contours from most views.
+inline ControlMesh bumpyBall(int n = 16) {
+  ControlMesh m;
+  auto id = [n](int side, int i, int j) { return (side * (n + 1) + j) * (n + 1) + i; };
+  // Each side: origin corner and two axes spanning it, wound outwards.
+  const Vec3 frames[6][3] = {{{-1, -1, 1}, {2, 0, 0}, {0, 2, 0}},  {{1, -1, -1}, {-2, 0, 0}, {0, 2, 0}},
+                             {{1, -1, 1}, {0, 0, -2}, {0, 2, 0}},  {{-1, -1, -1}, {0, 0, 2}, {0, 2, 0}},
+                             {{-1, 1, 1}, {2, 0, 0}, {0, 0, -2}},  {{-1, -1, -1}, {2, 0, 0}, {0, 0, 2}}};
+  for (int side = 0; side < 6; ++side) {
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        const Vec3* f = frames[side];
+        Vec3 c = f[0] + f[1] * (static_cast<double>(i) / n) + f[2] * (static_cast<double>(j) / n);
+        Vec3 d = c * (1.0 / std::sqrt(c.x * c.x + c.y * c.y + c.z * c.z));
+        double bump = 1.0 + 0.12 * std::sin(3 * d.x + 1) * std::sin(4 * d.y) * std::cos(2 * d.z) +
+                      0.06 * std::sin(7 * d.z + 2 * d.x);
+        m.points.push_back(d * bump);
+      }
+    }
+  }
+  for (int side = 0; side < 6; ++side) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        addFace(m, {id(side, i, j), id(side, i + 1, j), id(side, i + 1, j + 1), id(side, i, j + 1)});
+      }
+    }
+  }
+  return weldPoints(m);
+}
+
+// A chess pawn as a surface of revolution: `around` x `rows` faces (28 x 21 = 588), quads with a
+// triangle fan closing each pole (poles of valence `around`).
+inline ControlMesh pawn(int around = 28) {
+  // Profile (radius, height) from the bottom pole to the top pole.
+  const double profile[][2] = {{0.0, 0.0},   {0.55, 0.0},  {0.6, 0.06},  {0.58, 0.14}, {0.45, 0.2},
+                               {0.4, 0.28},  {0.36, 0.38}, {0.3, 0.52},  {0.25, 0.68}, {0.22, 0.82},
+                               {0.34, 0.88}, {0.36, 0.93}, {0.24, 0.97}, {0.2, 1.02},  {0.26, 1.1},
+                               {0.32, 1.2},  {0.33, 1.3},  {0.3, 1.4},   {0.22, 1.48}, {0.12, 1.53},
+                               {0.0, 1.55}};
+  const int rings = static_cast<int>(std::size(profile)) - 2;  // without the two poles
+  ControlMesh m;
+  m.points.push_back({0, profile[0][1], 0});
+  for (int r = 1; r <= rings; ++r) {
+    for (int k = 0; k < around; ++k) {
+      double a = 2 * std::numbers::pi * k / around;
+      m.points.push_back({profile[r][0] * std::cos(a), profile[r][1], -profile[r][0] * std::sin(a)});
+    }
+  }
+  const int top = static_cast<int>(m.points.size());
+  m.points.push_back({0, profile[rings + 1][1], 0});
+  auto id = [around](int r, int k) { return 1 + (r - 1) * around + (k % around); };
+  for (int k = 0; k < around; ++k) addFace(m, {0, id(1, k + 1), id(1, k)});
+  for (int r = 1; r < rings; ++r) {
+    for (int k = 0; k < around; ++k) addFace(m, {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
+  }
+  for (int k = 0; k < around; ++k) addFace(m, {id(rings, k), id(rings, k + 1), top});
   return m;
 }
 

@@ -1,0 +1,150 @@
+// reference_bench: where the exact reference spends its time, stage by stage, next to the
+// adaptive approximation (dicingRate 1) of the same request measured in the same run, on the
+// project's own dense meshes and the corpus shapes over ~500 faces (the corpus has none today;
+// --shapes adds any). Prints Markdown (bench/reference_results.md keeps the last run).
+//
+//   reference_bench [--size 1024] [--supersample 4] [--repeat 3] [--corpus DIR] [--shapes a,b]
+//
+// Each row is the best of --repeat warm runs. "adaptive ms" is approximation + raster of the
+// request without a reference; "ratio" is referenceMs / adaptive ms.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "api/obj_reader.h"
+#include "render/pipeline/render_job.h"
+#include "render/raster/rasterizer.h"
+#include "tests/unit/test_meshes.h"
+
+namespace fs = std::filesystem;
+using namespace limn;
+using render::pipeline::Method;
+using render::pipeline::RenderJob;
+using render::pipeline::RenderResult;
+
+namespace {
+
+struct NamedMesh {
+  std::string name;
+  render::mesh::ControlMesh mesh;
+};
+
+struct Config {
+  int size = 1024;
+  int supersample = 4;
+  int repeat = 3;
+  bool crossCheck = false;
+  std::string corpus = LIMN_SOURCE_DIR "/../shared/corpus/osd-shapes";
+  std::vector<std::string> shapes;
+};
+
+std::vector<std::string> splitList(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
+  return out;
+}
+
+std::vector<NamedMesh> loadMeshes(const Config& config) {
+  std::vector<NamedMesh> meshes = {
+      {"pawn (own, 588 faces)", testing::pawn()},
+      {"torus 40x25 (own, 1000 faces)", testing::torus(40, 25, false)},
+      {"bumpy ball (own, 1536 faces)", testing::bumpyBall(16)},
+  };
+  for (const std::string& shape : config.shapes) {
+    fs::path path = fs::path(config.corpus) / (shape + ".obj");
+    std::ifstream file(path);
+    if (!file) continue;
+    std::stringstream text;
+    text << file.rdbuf();
+    auto scheme = shape.rfind("loop_", 0) == 0       ? render::mesh::Scheme::Loop
+                  : shape.rfind("bilinear_", 0) == 0 ? render::mesh::Scheme::Bilinear
+                                                     : render::mesh::Scheme::CatmullClark;
+    meshes.push_back({shape, api::readObj(text.str(), scheme, {}).mesh});
+  }
+  return meshes;
+}
+
+RenderResult runBest(const RenderJob& job, render::pipeline::RenderContext& context, int repeat) {
+  render::pipeline::JobLimits limits;
+  RenderResult best = render::pipeline::run(job, limits, context, {});  // warm-up
+  for (int i = 0; i < repeat; ++i) {
+    RenderResult r = render::pipeline::run(job, limits, context, {});
+    if (r.timings.totalMs < best.timings.totalMs) best = std::move(r);
+  }
+  return best;
+}
+
+RenderJob adaptiveJob(const NamedMesh& m, const Config& config) {
+  RenderJob job;
+  job.mesh = m.mesh;
+  job.camera.width = job.camera.height = config.size;
+  job.method = Method::Adaptive;
+  job.params.dicingRate = 1.0;
+  job.params.metricSupersample = config.supersample;
+  job.params.referenceCrossCheck = config.crossCheck;
+  return job;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Config config;
+  for (int i = 1; i < argc; ++i) {
+    std::string flag = argv[i];
+    if (flag == "--cross-check") {
+      config.crossCheck = true;
+      continue;
+    }
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "%s needs a value\n", flag.c_str());
+      return 2;
+    }
+    std::string value = argv[++i];
+    if (flag == "--size") config.size = std::stoi(value);
+    else if (flag == "--supersample") config.supersample = std::stoi(value);
+    else if (flag == "--repeat") config.repeat = std::stoi(value);
+    else if (flag == "--corpus") config.corpus = value;
+    else if (flag == "--shapes") config.shapes = splitList(value);
+    else {
+      std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
+      return 2;
+    }
+  }
+  render::raster::Rasterizer rasterizer;
+  render::pipeline::RenderContext context{&rasterizer};
+  std::printf("renderer: %s; %u hardware threads; %d x %d, S = %d; best of %d warm runs%s\n\n",
+              rasterizer.device().renderer.c_str(), std::thread::hardware_concurrency(),
+              config.size, config.size, config.supersample, config.repeat,
+              config.crossCheck ? "; with the Embree subdivision cross-check" : "");
+
+  std::printf("| mesh | faces | adaptive ms | reference ms | ratio | ref. triangles | tessellate | "
+              "BVH | primary rays | Newton+shade | S-mask rays | outline | cross-check | metrics ms | "
+              "outlineHausdorffPx |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const NamedMesh& m : loadMeshes(config)) {
+    try {
+      RenderJob job = adaptiveJob(m, config);
+      RenderResult plain = runBest(job, context, config.repeat);
+      double adaptiveMs = plain.timings.approxMs + plain.timings.rasterMs;
+      job.reference = true;
+      RenderResult r = runBest(job, context, config.repeat);
+      const render::oracle::ReferenceStats& st = *r.timings.reference;
+      std::printf("| %s | %d | %.0f | %.0f | %.2f | %zu | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | "
+                  "%.0f | %.0f | %.3f |\n",
+                  m.name.c_str(), m.mesh.faceCount(), adaptiveMs, r.timings.referenceMs,
+                  r.timings.referenceMs / adaptiveMs, st.triangles, st.tessellateMs, st.bvhMs,
+                  st.traceMs, st.newtonMs, st.maskMs, st.outlineMs, r.timings.crossCheckMs,
+                  r.timings.metricsMs, r.metrics.silhouette->outlineHausdorffPx.value_or(-1));
+    } catch (const std::exception& e) {
+      std::printf("| %s | %d | failed: %s |\n", m.name.c_str(), m.mesh.faceCount(), e.what());
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}

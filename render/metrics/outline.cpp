@@ -1,0 +1,433 @@
+// locateOutline and compareOutlines: see outline.h.
+#include "render/metrics/outline.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+
+namespace limn::render::metrics {
+
+namespace {
+
+// ---- Locating ----
+
+// Interleaves the bits of two 32-bit numbers (x in the even bits).
+uint64_t interleave(uint32_t x, uint32_t y) {
+  auto spread = [](uint64_t v) {
+    v = (v | (v << 16)) & 0x0000FFFF0000FFFFull;
+    v = (v | (v << 8)) & 0x00FF00FF00FF00FFull;
+    v = (v | (v << 4)) & 0x0F0F0F0F0F0F0F0Full;
+    v = (v | (v << 2)) & 0x3333333333333333ull;
+    return (v | (v << 1)) & 0x5555555555555555ull;
+  };
+  return spread(x) | (spread(y) << 1);
+}
+
+uint32_t compact(uint64_t v) {
+  v &= 0x5555555555555555ull;
+  v = (v | (v >> 1)) & 0x3333333333333333ull;
+  v = (v | (v >> 2)) & 0x0F0F0F0F0F0F0F0Full;
+  v = (v | (v >> 4)) & 0x00FF00FF00FF00FFull;
+  v = (v | (v >> 8)) & 0x0000FFFF0000FFFFull;
+  return static_cast<uint32_t>((v | (v >> 16)) & 0x00000000FFFFFFFFull);
+}
+
+// The sample grid of a supersampled mask: sample (i, j) sits at the centre of mask pixel (i, j).
+// Samples are numbered in Morton order, so that sorted lists of samples, edges and crossings are
+// spatially coherent: queries get neighbouring points together (cheaper ray packets).
+struct SampleGrid {
+  int width, height, supersample;
+
+  Vec2 position(int i, int j) const {
+    return {(i + 0.5) / supersample, (j + 0.5) / supersample};
+  }
+  uint64_t sample(int i, int j) const {
+    return interleave(static_cast<uint32_t>(i), static_cast<uint32_t>(j));
+  }
+  int column(uint64_t s) const { return static_cast<int>(compact(s)); }
+  int row(uint64_t s) const { return static_cast<int>(compact(s >> 1)); }
+  // Grid edges: horizontal from sample (i, j) to (i + 1, j), vertical from (i, j) to (i, j + 1).
+  uint64_t horizontal(int i, int j) const { return 2 * sample(i, j); }
+  uint64_t vertical(int i, int j) const { return 2 * sample(i, j) + 1; }
+  void ends(uint64_t edge, Vec2* a, Vec2* b) const {
+    uint64_t s = edge / 2;
+    int i = column(s), j = row(s);
+    *a = position(i, j);
+    *b = (edge & 1) ? position(i, j + 1) : position(i + 1, j);
+  }
+};
+
+// A sorted list of keys with a value each, looked up by binary search.
+template <typename Value>
+struct SortedMap {
+  std::vector<uint64_t> keys;
+  std::vector<Value> values;
+  const Value* find(uint64_t key) const {
+    auto it = std::lower_bound(keys.begin(), keys.end(), key);
+    return it != keys.end() && *it == key ? &values[it - keys.begin()] : nullptr;
+  }
+};
+
+void sortUnique(std::vector<uint64_t>& keys) {
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+// Cells (by their first sample) whose four mask samples are not all alike, in sample order.
+// Runs of kRun cells whose two rows hold one value throughout are skipped after a branch-free
+// comparison (most of a mask is uniform), the rest is looked at cell by cell.
+std::vector<uint64_t> mixedCells(const Image& mask, const SampleGrid& grid) {
+  constexpr int kRun = 32;
+  const int w = grid.width, h = grid.height;
+  std::vector<std::vector<uint64_t>> perRow(std::max(0, h - 1));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h - 1, 8), [&](const tbb::blocked_range<int>& r) {
+    std::vector<uint8_t> top(w), bottom(w);
+    auto covered = [&](int j, std::vector<uint8_t>& out) {
+      const float* row = mask.pixels.data() + static_cast<size_t>(j) * w;
+      for (int i = 0; i < w; ++i) out[i] = row[i] > 0.5f;
+    };
+    covered(r.begin(), top);
+    for (int j = r.begin(); j < r.end(); ++j) {
+      covered(j + 1, bottom);
+      for (int i0 = 0; i0 + 1 < w; i0 += kRun) {
+        const int i1 = std::min(w - 1, i0 + kRun);  // cells i0 .. i1 - 1 use samples i0 .. i1
+        uint8_t differ = 0;
+        for (int i = i0; i <= i1; ++i) differ |= (top[i] ^ top[i0]) | (bottom[i] ^ top[i0]);
+        if (!differ) continue;
+        for (int i = i0; i < i1; ++i) {
+          uint8_t a = top[i];
+          if ((top[i + 1] ^ a) | (bottom[i] ^ a) | (bottom[i + 1] ^ a)) {
+            perRow[j].push_back(grid.sample(i, j));
+          }
+        }
+      }
+      std::swap(top, bottom);
+    }
+  });
+  std::vector<uint64_t> cells;
+  for (auto& row : perRow) cells.insert(cells.end(), row.begin(), row.end());
+  std::sort(cells.begin(), cells.end());
+  return cells;
+}
+
+// Coverage of the corners of every cell, by the query (not the mask: the two may disagree at a
+// sample by rounding, and the crossings must bracket the query's own boundary).
+SortedMap<char> cornerCoverage(const std::vector<uint64_t>& cells, const SampleGrid& grid,
+                               const CoverageQuery& query) {
+  SortedMap<char> corners;
+  for (uint64_t c : cells) {
+    int i = grid.column(c), j = grid.row(c);
+    for (int dj = 0; dj < 2; ++dj) {
+      for (int di = 0; di < 2; ++di) corners.keys.push_back(grid.sample(i + di, j + dj));
+    }
+  }
+  sortUnique(corners.keys);
+  std::vector<Vec2> points(corners.keys.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    points[k] = grid.position(grid.column(corners.keys[k]), grid.row(corners.keys[k]));
+  }
+  query(points, corners.values);
+  return corners;
+}
+
+// The edges of the cells whose two ends the query sees differently.
+std::vector<uint64_t> crossedEdges(const std::vector<uint64_t>& cells, const SampleGrid& grid,
+                                   const SortedMap<char>& corners) {
+  std::vector<uint64_t> edges;
+  auto covered = [&](int i, int j) { return *corners.find(grid.sample(i, j)) != 0; };
+  for (uint64_t c : cells) {
+    int i = grid.column(c), j = grid.row(c);
+    bool c00 = covered(i, j), c10 = covered(i + 1, j), c01 = covered(i, j + 1),
+         c11 = covered(i + 1, j + 1);
+    if (c00 != c10) edges.push_back(grid.horizontal(i, j));
+    if (c01 != c11) edges.push_back(grid.horizontal(i, j + 1));
+    if (c00 != c01) edges.push_back(grid.vertical(i, j));
+    if (c10 != c11) edges.push_back(grid.vertical(i + 1, j));
+  }
+  sortUnique(edges);
+  return edges;
+}
+
+// Bisects every bracket [inside, outside] at once (one query batch per halving) until it is
+// shorter than `tolerance`; the crossing is the bracket's middle.
+std::vector<Vec2> bisect(std::vector<Vec2> in, std::vector<Vec2> out, double length,
+                         const CoverageQuery& query, const CancelToken& cancel, double tolerance) {
+  const int steps = static_cast<int>(std::ceil(std::log2(length / tolerance)));
+  std::vector<Vec2> middles(in.size());
+  std::vector<char> covered;
+  for (int step = 0; step < steps && !in.empty(); ++step) {
+    cancel.check();
+    for (size_t k = 0; k < in.size(); ++k) {
+      middles[k] = {(in[k].x + out[k].x) / 2, (in[k].y + out[k].y) / 2};
+    }
+    query(middles, covered);
+    for (size_t k = 0; k < in.size(); ++k) (covered[k] ? in[k] : out[k]) = middles[k];
+  }
+  for (size_t k = 0; k < in.size(); ++k) {
+    middles[k] = {(in[k].x + out[k].x) / 2, (in[k].y + out[k].y) / 2};
+  }
+  return middles;
+}
+
+// The crossing on every crossed grid edge.
+std::vector<Vec2> bisectEdges(const std::vector<uint64_t>& edges, const SampleGrid& grid,
+                              const SortedMap<char>& corners, const CoverageQuery& query,
+                              const CancelToken& cancel, double tolerance) {
+  std::vector<Vec2> in(edges.size()), out(edges.size());  // covered end, uncovered end
+  for (size_t k = 0; k < edges.size(); ++k) {
+    Vec2 a, b;
+    grid.ends(edges[k], &a, &b);
+    bool aCovered = *corners.find(grid.sample(grid.column(edges[k] / 2), grid.row(edges[k] / 2)));
+    in[k] = aCovered ? a : b;
+    out[k] = aCovered ? b : a;
+  }
+  return bisect(std::move(in), std::move(out), 1.0 / grid.supersample, query, cancel, tolerance);
+}
+
+// Moves the middle of every segment onto the outline: a search along the chord's perpendicular,
+// half a cell either way, splits the segment in two at the crossing found (a segment whose
+// perpendicular sees one coverage at both ends stays whole). This halves the chord's error on
+// curves and puts a point on a sharp corner that falls inside a cell, which a chord between two
+// cell edges would cut by up to 0.09 cell.
+void splitSegments(Outline& outline, double cell, const CoverageQuery& query,
+                   const CancelToken& cancel, double tolerance) {
+  const size_t n = outline.segments.size();
+  std::vector<Vec2> ends(2 * n);
+  for (size_t k = 0; k < n; ++k) {
+    Vec2 a = outline.points[outline.segments[k].first];
+    Vec2 b = outline.points[outline.segments[k].second];
+    double dx = b.x - a.x, dy = b.y - a.y, len = std::hypot(dx, dy);
+    Vec2 m{(a.x + b.x) / 2, (a.y + b.y) / 2};
+    Vec2 normal = len > 0 ? Vec2{-dy / len, dx / len} : Vec2{0, 0};
+    ends[2 * k] = {m.x - normal.x * cell / 2, m.y - normal.y * cell / 2};
+    ends[2 * k + 1] = {m.x + normal.x * cell / 2, m.y + normal.y * cell / 2};
+  }
+  std::vector<char> covered;
+  query(ends, covered);
+  std::vector<Vec2> in, out;
+  std::vector<size_t> which;
+  for (size_t k = 0; k < n; ++k) {
+    if (covered[2 * k] == covered[2 * k + 1]) continue;
+    in.push_back(ends[2 * k + (covered[2 * k] ? 0 : 1)]);
+    out.push_back(ends[2 * k + (covered[2 * k] ? 1 : 0)]);
+    which.push_back(k);
+  }
+  std::vector<Vec2> middles = bisect(std::move(in), std::move(out), cell, query, cancel, tolerance);
+  outline.segments.reserve(n + which.size());
+  for (size_t i = 0; i < which.size(); ++i) {
+    const int middle = static_cast<int>(outline.points.size());
+    outline.points.push_back(middles[i]);
+    const int end = outline.segments[which[i]].second;
+    outline.segments[which[i]].second = middle;
+    outline.segments.emplace_back(middle, end);
+  }
+}
+
+// Joins the crossings of each cell as marching squares does. A cell crossed on all four edges
+// (a saddle) is resolved by the query at its centre: when the centre is covered like the corners
+// (i, j) and (i + 1, j + 1), those two are connected through it and the segments cut off the
+// other two corners.
+std::vector<std::pair<int, int>> joinCells(const std::vector<uint64_t>& cells,
+                                           const SampleGrid& grid, const SortedMap<char>& corners,
+                                           const std::vector<uint64_t>& edges,
+                                           const CoverageQuery& query) {
+  auto crossing = [&](uint64_t edge) {
+    auto it = std::lower_bound(edges.begin(), edges.end(), edge);
+    return it != edges.end() && *it == edge ? static_cast<int>(it - edges.begin()) : -1;
+  };
+  std::vector<std::pair<int, int>> segments;
+  std::vector<uint64_t> saddles;
+  for (uint64_t c : cells) {
+    int i = grid.column(c), j = grid.row(c);
+    // Around the cell: top, right, bottom, left.
+    int e[4] = {crossing(grid.horizontal(i, j)), crossing(grid.vertical(i + 1, j)),
+                crossing(grid.horizontal(i, j + 1)), crossing(grid.vertical(i, j))};
+    int found[4], n = 0;
+    for (int k : e) {
+      if (k >= 0) found[n++] = k;
+    }
+    if (n == 2) segments.emplace_back(found[0], found[1]);
+    if (n == 4) saddles.push_back(c);
+  }
+  if (saddles.empty()) return segments;
+  std::vector<Vec2> centres(saddles.size());
+  for (size_t k = 0; k < saddles.size(); ++k) {
+    Vec2 p = grid.position(grid.column(saddles[k]), grid.row(saddles[k]));
+    centres[k] = {p.x + 0.5 / grid.supersample, p.y + 0.5 / grid.supersample};
+  }
+  std::vector<char> centreCovered;
+  query(centres, centreCovered);
+  for (size_t k = 0; k < saddles.size(); ++k) {
+    int i = grid.column(saddles[k]), j = grid.row(saddles[k]);
+    int top = crossing(grid.horizontal(i, j)), right = crossing(grid.vertical(i + 1, j)),
+        bottom = crossing(grid.horizontal(i, j + 1)), left = crossing(grid.vertical(i, j));
+    bool diagonalJoined = (centreCovered[k] != 0) == (*corners.find(grid.sample(i, j)) != 0);
+    if (diagonalJoined) {  // cut off corners (i + 1, j) and (i, j + 1)
+      segments.emplace_back(top, right);
+      segments.emplace_back(bottom, left);
+    } else {  // cut off corners (i, j) and (i + 1, j + 1)
+      segments.emplace_back(top, left);
+      segments.emplace_back(right, bottom);
+    }
+  }
+  return segments;
+}
+
+// ---- Comparing ----
+
+double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
+  double dx = b.x - a.x, dy = b.y - a.y;
+  double len2 = dx * dx + dy * dy;
+  double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+// The segments of an outline (lone points as zero-length ones) bucketed in a uniform grid, for
+// nearest-segment queries that look at a few cells around the query point.
+class SegmentIndex {
+ public:
+  SegmentIndex(const Outline& outline, double x0, double y0, double x1, double y1)
+      : outline_(outline) {
+    std::vector<char> joined(outline.points.size(), 0);
+    for (auto [a, b] : outline.segments) {
+      items_.push_back({a, b});
+      joined[a] = joined[b] = 1;
+    }
+    for (size_t k = 0; k < joined.size(); ++k) {
+      if (!joined[k]) items_.push_back({static_cast<int>(k), static_cast<int>(k)});
+    }
+    // About four cells per item, at least half a pixel each.
+    double area = std::max(1.0, (x1 - x0) * (y1 - y0));
+    cell_ = std::max(0.5, std::sqrt(area / (4.0 * std::max<size_t>(1, items_.size()))));
+    x0_ = x0;
+    y0_ = y0;
+    nx_ = std::max(1, static_cast<int>(std::ceil((x1 - x0) / cell_)));
+    ny_ = std::max(1, static_cast<int>(std::ceil((y1 - y0) / cell_)));
+    std::vector<int> counts(static_cast<size_t>(nx_) * ny_ + 1, 0);
+    forEachCell([&](size_t cell, int) { ++counts[cell + 1]; });
+    for (size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+    start_ = counts;
+    entries_.resize(counts.back());
+    forEachCell([&](size_t cell, int item) { entries_[counts[cell]++] = item; });
+  }
+
+  // Distance from p (inside the index's bounds) to the nearest item.
+  double nearest(Vec2 p) const {
+    constexpr int kMaxRing = 16;  // beyond it, every item is looked at
+    int cx = cellX(p.x), cy = cellY(p.y);
+    double best = std::numeric_limits<double>::infinity();
+    for (int ring = 0; ring <= kMaxRing; ++ring) {
+      for (int y = cy - ring; y <= cy + ring; ++y) {
+        if (y < 0 || y >= ny_) continue;
+        bool edgeRow = y == cy - ring || y == cy + ring;
+        for (int x = cx - ring; x <= cx + ring; x += edgeRow ? 1 : 2 * std::max(ring, 1)) {
+          if (x < 0 || x >= nx_) continue;
+          size_t cell = static_cast<size_t>(y) * nx_ + x;
+          for (int k = start_[cell]; k < start_[cell + 1]; ++k) best = std::min(best, distance(p, entries_[k]));
+        }
+      }
+      // Items in rings further out are at least `ring` cells away.
+      if (best <= ring * cell_) return best;
+    }
+    for (size_t k = 0; k < items_.size(); ++k) best = std::min(best, distance(p, static_cast<int>(k)));
+    return best;
+  }
+
+ private:
+  int cellX(double x) const { return std::clamp(static_cast<int>((x - x0_) / cell_), 0, nx_ - 1); }
+  int cellY(double y) const { return std::clamp(static_cast<int>((y - y0_) / cell_), 0, ny_ - 1); }
+  double distance(Vec2 p, int item) const {
+    return pointSegmentDistance(p, outline_.points[items_[item].first],
+                                outline_.points[items_[item].second]);
+  }
+  template <typename Fn>
+  void forEachCell(Fn fn) const {
+    for (size_t k = 0; k < items_.size(); ++k) {
+      Vec2 a = outline_.points[items_[k].first], b = outline_.points[items_[k].second];
+      for (int y = cellY(std::min(a.y, b.y)); y <= cellY(std::max(a.y, b.y)); ++y) {
+        for (int x = cellX(std::min(a.x, b.x)); x <= cellX(std::max(a.x, b.x)); ++x) {
+          fn(static_cast<size_t>(y) * nx_ + x, static_cast<int>(k));
+        }
+      }
+    }
+  }
+
+  const Outline& outline_;
+  std::vector<std::pair<int, int>> items_;
+  double cell_ = 1, x0_ = 0, y0_ = 0;
+  int nx_ = 1, ny_ = 1;
+  std::vector<int> start_, entries_;
+};
+
+bool insideFrame(const Outline& o, Vec2 p) {
+  return p.x >= 0.5 && p.y >= 0.5 && p.x <= o.frameWidth - 0.5 && p.y <= o.frameHeight - 0.5;
+}
+
+// Distances from every point of `from` inside its frame to the nearest item of `index`.
+std::vector<double> directedDistances(const Outline& from, const SegmentIndex& index) {
+  std::vector<Vec2> measured;
+  for (Vec2 p : from.points) {
+    if (insideFrame(from, p)) measured.push_back(p);
+  }
+  std::vector<double> d(measured.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, d.size(), 256),
+                    [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) d[k] = index.nearest(measured[k]);
+  });
+  return d;
+}
+
+}  // namespace
+
+Outline locateOutline(const Image& mask, int supersample, const CoverageQuery& query,
+                      const CancelToken& cancel, double tolerancePx) {
+  if (mask.channels != 1 || supersample < 1) {
+    throw std::invalid_argument("locateOutline: a one-channel mask and a supersample >= 1");
+  }
+  SampleGrid grid{mask.width, mask.height, supersample};
+  std::vector<uint64_t> cells = mixedCells(mask, grid);
+  cancel.check();
+  Outline outline;
+  outline.frameWidth = static_cast<double>(mask.width) / supersample;
+  outline.frameHeight = static_cast<double>(mask.height) / supersample;
+  if (cells.empty()) return outline;
+  SortedMap<char> corners = cornerCoverage(cells, grid, query);
+  std::vector<uint64_t> edges = crossedEdges(cells, grid, corners);
+  outline.points = bisectEdges(edges, grid, corners, query, cancel, tolerancePx);
+  outline.segments = joinCells(cells, grid, corners, edges, query);
+  splitSegments(outline, 1.0 / supersample, query, cancel, tolerancePx);
+  return outline;
+}
+
+OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx) {
+  if (a.empty() && b.empty()) return {};
+  if (a.empty() || b.empty()) return {farPx, farPx};
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  for (const Outline* o : {&a, &b}) {
+    for (Vec2 p : o->points) {
+      x0 = std::min(x0, p.x);
+      y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x);
+      y1 = std::max(y1, p.y);
+    }
+  }
+  SegmentIndex indexA(a, x0, y0, x1, y1), indexB(b, x0, y0, x1, y1);
+  std::vector<double> ab = directedDistances(a, indexB), ba = directedDistances(b, indexA);
+  OutlineDistances result;
+  double sum = 0;
+  for (const std::vector<double>* d : {&ab, &ba}) {
+    for (double v : *d) {
+      result.hausdorffPx = std::max(result.hausdorffPx, v);
+      sum += v;
+    }
+  }
+  if (!ab.empty() || !ba.empty()) result.meanPx = sum / static_cast<double>(ab.size() + ba.size());
+  return result;
+}
+
+}  // namespace limn::render::metrics
