@@ -5,7 +5,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <string>
 
@@ -70,12 +72,55 @@ struct PassImages {
   }
 };
 
+// Output pixels the outline of the tessellation may cross (see renderReference in reference.h):
+// the screen bounding boxes of every triangle whose geometric facing differs from the facing of
+// one of its vertex normals, or whose vertex normals disagree, and of every triangle of a face
+// on a border. The coverage of a triangle mesh changes only across an edge between a front- and
+// a back-facing triangle, or across a boundary edge, and at least one triangle at each such
+// edge is marked: so a thin spike or sliver between pixel centres is not missed.
+std::vector<char> outlineCandidates(const ReferenceTessellation& tessellation, const Camera& camera) {
+  const tessellate::TriangleMesh& mesh = tessellation.mesh;
+  const int width = camera.width(), height = camera.height();
+  std::vector<char> marked(static_cast<size_t>(width) * height, 0);
+  auto toVec3 = [](const Vec3f& v) { return Vec3{v.x, v.y, v.z}; };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.triangleCount(), 4096),
+                    [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); ++t) {
+      const uint32_t* v = &mesh.indices[3 * t];
+      Vec3 p[3] = {toVec3(mesh.positions[v[0]]), toVec3(mesh.positions[v[1]]),
+                   toVec3(mesh.positions[v[2]])};
+      bool candidate = tessellation.borderFaces[mesh.triangleFaces[t]] != 0;
+      if (!candidate) {
+        Vec3 centroid = (p[0] + p[1] + p[2]) * (1.0 / 3.0);
+        bool facing = dot(cross(p[1] - p[0], p[2] - p[0]), camera.viewVector(centroid)) < 0;
+        for (int k = 0; k < 3 && !candidate; ++k) {
+          bool vertexFacing = dot(toVec3(mesh.normals[v[k]]), camera.viewVector(p[k])) < 0;
+          candidate = vertexFacing != facing;
+        }
+      }
+      if (!candidate) continue;
+      double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+      for (const Vec3& q : p) {
+        Vec3 s = camera.project(q);
+        x0 = std::min(x0, s.x), y0 = std::min(y0, s.y), x1 = std::max(x1, s.x), y1 = std::max(y1, s.y);
+      }
+      int i0 = std::max(0, static_cast<int>(std::floor(x0))), j0 = std::max(0, static_cast<int>(std::floor(y0)));
+      int i1 = std::min(width - 1, static_cast<int>(std::floor(x1))), j1 = std::min(height - 1, static_cast<int>(std::floor(y1)));
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+          std::atomic_ref<char>(marked[static_cast<size_t>(j) * width + i]).store(1, std::memory_order_relaxed);
+        }
+      }
+    }
+  });
+  return marked;
+}
+
 // Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
-// those with an 8-neighbour of other coverage, and those where the hint's block is mixed or
-// disagrees with the pixel.
-std::vector<char> pixelsToRefine(const std::vector<char>& covered, int width, int height,
-                                 const Image* hint, int s) {
-  std::vector<char> refine(covered.size(), 0);
+// outline candidates, those with an 8-neighbour of other coverage, and those where the hint's
+// block is mixed or disagrees with the pixel.
+std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
+                                 int width, int height, const Image* hint, int s) {
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y) {
       for (int x = 0; x < width; ++x) {
@@ -88,6 +133,7 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, int width, in
             differs = covered[static_cast<size_t>(ny) * width + nx] != covered[p];
           }
         }
+        if (refine[p]) continue;
         if (!differs && hint) {
           for (int j = 0; j < s && !differs; ++j) {
             for (int i = 0; i < s && !differs; ++i) {
@@ -203,7 +249,8 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
     if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
       hint = nullptr;
     }
-    std::vector<char> refine = pixelsToRefine(coverage, width, height, hint, s);
+    std::vector<char> refine = pixelsToRefine(coverage, outlineCandidates(tessellation, camera),
+                                              width, height, hint, s);
     for (char r : refine) stats.refinedPixels += r != 0;
     result.images.supersampledMask = castCoverageRefined(scene, camera, s, refine, coverage, cancel);
     result.images.supersample = s;

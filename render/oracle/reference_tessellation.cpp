@@ -13,9 +13,12 @@ namespace Far = OpenSubdiv::Far;
 namespace {
 
 // Faces whose limit surface carries an outline: a silhouette, a boundary of the surface (mesh
-// boundary, hole, faces without limit), or a crease across which facing changes.
+// boundary, hole, faces without limit), or a crease across which facing changes. `border`
+// gets the faces of the second kind.
 std::vector<char> outlineFaces(const subdiv::LimitSurface& surface,
-                               const std::vector<FaceProbe>& probes) {
+                               const std::vector<FaceProbe>& probes,
+                               std::vector<char>& borderFaces) {
+  borderFaces.assign(surface.faceCount(), 0);
   const Far::TopologyLevel& base = surface.baseLevel();
   std::vector<char> outline(surface.faceCount(), 0);
   for (int f = 0; f < surface.faceCount(); ++f) outline[f] = probes[f].probed && probes[f].silhouette;
@@ -34,6 +37,9 @@ std::vector<char> outlineFaces(const subdiv::LimitSurface& surface,
     bool crease = base.GetEdgeSharpness(e) > 0 && gMin < tau && gMax > -tau;
     if (border || crease) {
       for (int f : faces) outline[f] = outline[f] || probes[f].probed;
+    }
+    if (border) {
+      for (int f : faces) borderFaces[f] = 1;
     }
   }
   return outline;
@@ -82,12 +88,12 @@ double estimateTriangles(const std::vector<FaceProbe>& probes, const std::vector
 ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface,
                                              const Camera& camera, const CancelToken& cancel) {
   std::vector<FaceProbe> probes = probeFaces(surface, camera);
-  std::vector<char> outline = outlineFaces(surface, probes);
+  ReferenceTessellation result;
+  std::vector<char> outline = outlineFaces(surface, probes, result.borderFaces);
   cancel.check();
 
   // Within the budget, both the outline's segments and the dicing scale as 1 / sqrt(error):
   // triangles go as 1 / error.
-  ReferenceTessellation result;
   result.outlineErrorPx = kOutlineChordErrorPx;
   result.dicingRate = kReferenceDicingRate;
   double estimate = estimateTriangles(probes, outline, kOutlineChordErrorPx, kReferenceDicingRate);

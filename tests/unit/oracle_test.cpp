@@ -363,8 +363,18 @@ struct View {
   Vec3 offset;  // eye - centre, in bounding-box diagonals
 };
 
+// A cube with an infinitely sharp corner and one infinitely sharp edge: the corner's tip is a
+// spike thinner than a pixel.
+ControlMesh sharpCornerCube() {
+  ControlMesh m = testing::cube();
+  m.corners.push_back({3, 10.0f});
+  m.creases.push_back({0, 1, 10.0f});
+  return m;
+}
+
 std::vector<View> ownViews() {
   return {{"creased torus", testing::torus(12, 8, true), {0.8, -1.5, 3.0}},
+          {"cube with a sharp corner", sharpCornerCube(), {0.9, 1.1, 2.2}},
           {"pawn", testing::pawn(), {1.2, 0.7, 1.6}},
           {"bumpy ball", testing::bumpyBall(8), {-0.9, 0.4, 1.1}},
           {"cube, orthographic", testing::cube(), {0.7, 0.9, 1.3}},
