@@ -25,9 +25,9 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
       out.presubdivided =
           std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh));
     } catch (const InputError& e) {
-      // Refining some non-manifold meshes makes interior vertices of valence 2, which the
-      // OpenSubdiv version limn runs on cannot evaluate around. Draw the mesh unrefined if the
-      // method can; otherwise say why in terms of the mesh the client sent.
+      // A safety net: if OpenSubdiv refuses the refined topology (interior valence-2 vertices
+      // that refining non-manifold meshes makes no longer are refused), draw the mesh unrefined
+      // if the method can; otherwise say why in terms of the mesh the client sent.
       if (!silhouette::hasSimpleFaces(mesh)) {
         throw InputError(InputError::Kind::InvalidMesh, "presubdivide",
                          std::string("the silhouette method must refine this mesh once (it has "

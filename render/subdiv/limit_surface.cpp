@@ -1,5 +1,6 @@
 #include "render/subdiv/limit_surface.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -10,6 +11,7 @@
 #include <opensubdiv/far/topologyDescriptor.h>
 
 #include "render/core/error.h"
+#include "render/subdiv/far_patch_surface.h"
 
 namespace limn::render::subdiv {
 
@@ -110,10 +112,13 @@ std::unique_ptr<Far::TopologyRefiner> createTopologyRefiner(const mesh::ControlM
   return refiner;
 }
 
-LimitSurface::LimitSurface(mesh::ControlMesh mesh)
+LimitSurface::LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoOnFarPatches)
     : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(createTopologyRefiner(mesh_)) {
-  rejectUnsupportedTopology();
-  buildFaceSurfaces();
+  std::vector<int> farPatchFaces = facesBfrCannotEvaluate();
+  farPatchFaces.insert(farPatchFaces.end(), alsoOnFarPatches.begin(), alsoOnFarPatches.end());
+  std::sort(farPatchFaces.begin(), farPatchFaces.end());
+  farPatchFaces.erase(std::unique(farPatchFaces.begin(), farPatchFaces.end()), farPatchFaces.end());
+  buildFaceSurfaces(farPatchFaces);
   computeControlLimits();
 }
 
@@ -127,23 +132,26 @@ const Far::TopologyLevel& LimitSurface::baseLevel() const { return refiner_->Get
 
 // OpenSubdiv 3.5.0 (the Debian 12 version) reads uninitialised memory and may crash when Bfr
 // builds the irregular patch of a face around an interior vertex of valence 2 (fixed upstream
-// after 3.6). Such meshes are refused with a 422 that names the vertex, rather than risking the
-// worker process.
-void LimitSurface::rejectUnsupportedTopology() const {
-  if (mesh_.scheme == mesh::Scheme::Bilinear) return;  // bilinear faces have no irregular patches
+// after 3.6). Those faces go to Far's adaptive patch table instead, which handles them.
+std::vector<int> LimitSurface::facesBfrCannotEvaluate() const {
+  std::vector<int> faces;
+  if (mesh_.scheme == mesh::Scheme::Bilinear) return faces;  // bilinear has no irregular patches
   const Far::TopologyLevel& base = baseLevel();
   for (int v = 0; v < base.GetNumVertices(); ++v) {
     Far::ConstIndexArray edges = base.GetVertexEdges(v);
     if (edges.size() != 2 || base.IsVertexBoundary(v) || base.IsVertexNonManifold(v)) continue;
-    if (base.GetVertexFaces(v).size() != 2) continue;
-    throw InputError(InputError::Kind::InvalidMesh, "vertex " + std::to_string(v),
-                     "vertex " + std::to_string(v) +
-                         " is an interior vertex of valence 2: the OpenSubdiv version limn runs "
-                         "on (3.5.0) cannot evaluate the limit surface around it safely");
+    Far::ConstIndexArray incident = base.GetVertexFaces(v);
+    if (incident.size() != 2) continue;
+    faces.insert(faces.end(), incident.begin(), incident.end());
   }
+  return faces;
 }
 
-void LimitSurface::buildFaceSurfaces() {
+void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces) {
+  if (!farPatchFaces.empty()) {
+    // Far refines its refiner adaptively; refiner_ is shared (baseLevel()), so it gets its own.
+    farPatches_ = std::make_unique<FarPatchSurface>(createRefiner(), farPatchFaces, mesh_.points);
+  }
   Bfr::RefinerSurfaceFactory<>::Options options;
   options.SetApproxLevelSmooth(kApproxLevel);
   options.SetApproxLevelSharp(kApproxLevel);
@@ -160,17 +168,23 @@ void LimitSurface::buildFaceSurfaces() {
   surfaces_.reserve(mesh_.faceCount());
   for (int f = 0; f < mesh_.faceCount(); ++f) {
     if (!factory.FaceHasLimitSurface(f)) continue;
+    if (std::binary_search(farPatchFaces.begin(), farPatchFaces.end(), f)) {
+      faces_[f].valid = farPatches_->covers(f, parameterization(f));
+      faces_[f].onFarPatches = true;
+      continue;
+    }
     FaceSurface fs;
     if (!factory.InitVertexSurface(f, &fs.surface) || !fs.surface.IsValid()) continue;
     fs.patchPoints.resize(static_cast<size_t>(fs.surface.GetNumPatchPoints()) * 3);
     fs.surface.PreparePatchPoints(meshPoints.data(), xyz, fs.patchPoints.data(), xyz);
-    faces_[f] = {true, static_cast<int>(surfaces_.size())};
+    faces_[f] = {true, false, static_cast<int>(surfaces_.size())};
     surfaces_.push_back(std::move(fs));
   }
 }
 
 Bfr::Parameterization LimitSurface::parameterization(int face) const {
-  if (faces_[face].valid) return surfaces_[faces_[face].surfaceIndex].surface.GetParameterization();
+  const int surface = faces_[face].surfaceIndex;
+  if (surface >= 0) return surfaces_[surface].surface.GetParameterization();
   return Bfr::Parameterization(schemeType(mesh_.scheme), mesh_.faceVertexCounts[face]);
 }
 
@@ -186,31 +200,45 @@ Vec2 LimitSurface::centerUV(int face) const {
   return {uv[0], uv[1]};
 }
 
-LimitSample LimitSurface::evaluate(int face, double u, double v) const {
+void LimitSurface::evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du,
+                                       Vec3& dv) const {
+  if (faces_[face].onFarPatches) {
+    farPatches_->evaluate(face, parameterization(face), u, v, position, du, dv);
+    return;
+  }
   const FaceSurface& fs = surfaces_[faces_[face].surfaceIndex];
   const Bfr::Surface<double>::PointDescriptor xyz(3);
   double uv[2] = {u, v};
-  double p[3], du[3], dv[3];
-  fs.surface.Evaluate(uv, fs.patchPoints.data(), xyz, p, du, dv);
+  double p[3], dpu[3], dpv[3];
+  fs.surface.Evaluate(uv, fs.patchPoints.data(), xyz, p, dpu, dpv);
+  position = {p[0], p[1], p[2]};
+  du = {dpu[0], dpu[1], dpu[2]};
+  dv = {dpv[0], dpv[1], dpv[2]};
+}
+
+LimitSample LimitSurface::evaluate(int face, double u, double v) const {
   LimitSample s;
-  s.position = {p[0], p[1], p[2]};
-  s.du = {du[0], du[1], du[2]};
-  s.dv = {dv[0], dv[1], dv[2]};
+  evaluateDerivatives(face, u, v, s.position, s.du, s.dv);
   Vec3 n = cross(s.du, s.dv);
   double scale = dot(s.du, s.du) + dot(s.dv, s.dv);
   if (dot(n, n) <= 1e-20 * scale * scale) {
     // Degenerate derivatives (e.g. at a corner of some irregular patches): the normal there is
     // the limit of the normals approaching it, taken from a point nudged towards the centre.
     Vec2 c = centerUV(face);
-    double uvn[2] = {u + (c.x - u) * 1e-5, v + (c.y - v) * 1e-5};
-    fs.surface.Evaluate(uvn, fs.patchPoints.data(), xyz, p, du, dv);
-    n = cross(Vec3{du[0], du[1], du[2]}, Vec3{dv[0], dv[1], dv[2]});
+    Vec3 p, du, dv;
+    evaluateDerivatives(face, u + (c.x - u) * 1e-5, v + (c.y - v) * 1e-5, p, du, dv);
+    n = cross(du, dv);
   }
   s.normal = normalize(n);
   return s;
 }
 
 Vec3 LimitSurface::position(int face, double u, double v) const {
+  if (faces_[face].onFarPatches) {
+    Vec3 p, du, dv;
+    evaluateDerivatives(face, u, v, p, du, dv);
+    return p;
+  }
   const FaceSurface& fs = surfaces_[faces_[face].surfaceIndex];
   const Bfr::Surface<double>::PointDescriptor xyz(3);
   double uv[2] = {u, v};

@@ -5,6 +5,10 @@
 // surface and patch points are prepared at construction, so evaluate() is const and safe to
 // call from many threads at once.
 //
+// Faces around an interior vertex of valence 2, whose Bfr patches OpenSubdiv 3.5.0 cannot build
+// safely, are evaluated through Far's adaptive patch table instead (FarPatchSurface), in the
+// same parameterisation; callers see no difference.
+//
 // Parameterisation is Bfr's: quads (u, v) in [0,1]^2, triangles (u, v) with u + v <= 1, and
 // other faces of Catmull-Clark meshes tiled into quad sub-faces (see Bfr::Parameterization).
 // The approximation levels Bfr uses near irregular features are fixed (kApproxLevel) so that
@@ -21,6 +25,8 @@
 #include "render/mesh/control_mesh.h"
 
 namespace limn::render::subdiv {
+
+class FarPatchSurface;
 
 // Bfr refinement level used to approximate irregular regions, for smooth and sharp features
 // alike. At 6, Bfr, Far and Embree agree to about 4e-7 of the model size.
@@ -40,9 +46,10 @@ std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> createTopologyRefiner(
 
 class LimitSurface {
  public:
-  // Throws InputError(InvalidMesh) when OpenSubdiv cannot build the topology, or when it has
-  // an interior vertex of valence 2 (OpenSubdiv 3.5.0's Bfr mishandles those).
-  explicit LimitSurface(mesh::ControlMesh mesh);
+  // Throws InputError(InvalidMesh) when OpenSubdiv cannot build the topology.
+  // `alsoOnFarPatches` (for tests): faces to evaluate through Far's patch table although Bfr
+  // could, to compare the two.
+  explicit LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoOnFarPatches = {});
   ~LimitSurface();
   LimitSurface(const LimitSurface&) = delete;
   LimitSurface& operator=(const LimitSurface&) = delete;
@@ -60,6 +67,8 @@ class LimitSurface {
   // ---- Per-face limit surfaces ----
   // False for holes and for faces OpenSubdiv gives no limit surface.
   bool hasLimit(int face) const { return faces_[face].valid; }
+  // True when the face is evaluated through Far's patch table rather than Bfr.
+  bool onFarPatches(int face) const { return faces_[face].onFarPatches; }
   OpenSubdiv::Bfr::Parameterization parameterization(int face) const;
   // Parametric coordinates of the face's k-th corner.
   Vec2 cornerUV(int face, int corner) const;
@@ -77,19 +86,23 @@ class LimitSurface {
 
  private:
   struct FaceSurface;
-  void rejectUnsupportedTopology() const;
-  void buildFaceSurfaces();
+  std::vector<int> facesBfrCannotEvaluate() const;
+  void buildFaceSurfaces(const std::vector<int>& farPatchFaces);
   void computeControlLimits();
+  void evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du,
+                           Vec3& dv) const;
 
   mesh::ControlMesh mesh_;
   Bounds bounds_;
   std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> refiner_;
   struct FaceData {
     bool valid = false;
-    int surfaceIndex = -1;
+    bool onFarPatches = false;
+    int surfaceIndex = -1;  // into surfaces_, for faces on Bfr
   };
   std::vector<FaceData> faces_;
   std::vector<FaceSurface> surfaces_;
+  std::unique_ptr<FarPatchSurface> farPatches_;  // only when some face needs it
   std::vector<Vec3> controlLimitPositions_;
   std::vector<Vec3> controlLimitNormals_;
 };

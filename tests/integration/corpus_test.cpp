@@ -105,6 +105,32 @@ std::map<std::string, std::pair<std::string, std::string>> ownMeshes() {  // nam
     }
     meshes["open_grid"] = {"catmull-clark", obj.str()};
   }
+  // Open 4 x 4 grid whose middle quad is split in two through a lifted vertex: an interior vertex
+  // of valence 2, whose two faces are evaluated on Far's patches rather than Bfr's.
+  {
+    std::ostringstream obj;
+    const int n = 4;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        double x = double(i) / n - 0.5, y = double(j) / n - 0.5;
+        obj << "v " << x << " " << y << " " << 0.2 * std::sin(3 * x + 1) * std::cos(2 * y) << "\n";
+      }
+    }
+    obj << "v 0.175 0.095 0.35\n";  // vertex (n + 1)^2 + 1, above the middle quad
+    const int lifted = (n + 1) * (n + 1) + 1;
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        int a = j * (n + 1) + i + 1, b = a + 1, c = a + n + 2, d = a + n + 1;
+        if (i == n / 2 && j == n / 2) {
+          obj << "f " << a << " " << b << " " << c << " " << lifted << "\n";
+          obj << "f " << a << " " << lifted << " " << c << " " << d << "\n";
+        } else {
+          obj << "f " << a << " " << b << " " << c << " " << d << "\n";
+        }
+      }
+    }
+    meshes["val2_grid"] = {"catmull-clark", obj.str()};
+  }
   {
     const double t = (1 + std::sqrt(5.0)) / 2;
     std::ostringstream obj;
@@ -240,6 +266,13 @@ TEST_P(EveryShape, EveryMethodAnswers) {
   const Shape& shape = GetParam();
   for (const char* method : {"coarse", "uniform", "adaptive", "limit", "silhouette"}) {
     auto r = render(shape.obj, shape.scheme, method, 128, false, 2, R"(,"mask","depth","normal")");
+    // Interior valence-2 vertices used to be refused; their faces now go to Far's patches.
+    if (shape.name.find("val2") != std::string::npos) {
+      ASSERT_EQ(r->status, 200) << method << ": "
+                                << (r->body.HasMember("error")
+                                        ? r->body["error"]["message"].GetString()
+                                        : "");
+    }
     if (r->status == 422) {
       ASSERT_TRUE(r->body.HasMember("error")) << method;
       EXPECT_STREQ(r->body["error"]["code"].GetString(), "invalid_mesh");
@@ -273,10 +306,14 @@ TEST_P(EveryShape, ErrorsAgainstTheReference) {
   RecordProperty("adaptiveHausdorffPx", std::to_string(adaptivePx));
   // The two reference paths agree to one supersampled pixel (the finest step a mask
   // Hausdorff distance has: 0.25 px at S = 4) and on average to a hundredth of a pixel.
-  // Known exception: on catmark_gregory_test1 Embree's own subdivision surface departs from
-  // OpenSubdiv's (the server warns); the reference is OpenSubdiv's.
+  // Known exceptions: on catmark_gregory_test1 and around own_val2_grid's lifted valence-2
+  // vertex Embree's own subdivision surface departs from OpenSubdiv's (the server warns; on the
+  // latter by 234 px, while Far's uniform level 4, pushed to the limit by PrimvarRefiner and
+  // independent of the patches, is within 0.25 px of the reference). The reference is
+  // OpenSubdiv's.
   const rapidjson::Value& stats = adaptive->body["stats"];
-  if (stats.HasMember("referenceCrossCheckPx") && shape.name != "catmark_gregory_test1") {
+  if (stats.HasMember("referenceCrossCheckPx") && shape.name != "catmark_gregory_test1" &&
+      shape.name != "own_val2_grid") {
     EXPECT_LE(stats["referenceCrossCheckPx"].GetDouble(), 0.25) << "two references disagree";
     EXPECT_LE(stats["referenceCrossCheckMeanPx"].GetDouble(), 0.01) << "two references disagree";
   }

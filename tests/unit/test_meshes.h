@@ -197,6 +197,23 @@ inline ControlMesh pawn(int around = 28) {
     for (int k = 0; k < around; ++k) addFace(m, {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
   }
   for (int k = 0; k < around; ++k) addFace(m, {id(rings, k), id(rings, k + 1), top});
+
+// The n x n grid (n >= 2) with its middle quad split in two through an extra vertex lifted
+// above it: that vertex is interior with valence 2 (as in the corpus's catmark_val2_interior).
+// The two split faces are the last two faces; the extra vertex is the last point.
+inline ControlMesh gridWithValenceTwoVertex(int n = 4, double amplitude = 0.2) {
+  ControlMesh m = grid(n, amplitude);
+  const int split = (n / 2) * n + n / 2;
+  const int* q = &m.faceVertexIndices[4 * split];
+  const int a = q[0], b = q[1], c = q[2], d = q[3];
+  Vec3 middle = (m.points[a] + m.points[b] + m.points[c] + m.points[d]) * 0.25;
+  m.points.push_back(middle + Vec3{0.05, -0.03, 0.3});
+  const int x = static_cast<int>(m.points.size()) - 1;
+  m.faceVertexIndices.erase(m.faceVertexIndices.begin() + 4 * split,
+                            m.faceVertexIndices.begin() + 4 * split + 4);
+  m.faceVertexCounts.pop_back();
+  addFace(m, {a, b, c, x});
+  addFace(m, {a, x, c, d});
   return m;
 }
 
