@@ -197,6 +197,8 @@ inline ControlMesh pawn(int around = 28) {
     for (int k = 0; k < around; ++k) addFace(m, {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
   }
   for (int k = 0; k < around; ++k) addFace(m, {id(rings, k), id(rings, k + 1), top});
+  return m;
+}
 
 // The n x n grid (n >= 2) with its middle quad split in two through an extra vertex lifted
 // above it: that vertex is interior with valence 2 (as in the corpus's catmark_val2_interior).
