@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -115,6 +116,30 @@ std::vector<uint64_t> mixedCells(const Image& mask, const SampleGrid& grid) {
   return cells;
 }
 
+// The mixed cells in and along the blocks of the flagged output pixels: cells whose first
+// sample lies in [x S - 1, x S + S - 1] x [y S - 1, y S + S - 1] for a flagged (x, y).
+std::vector<uint64_t> mixedCellsIn(const Image& mask, const SampleGrid& grid,
+                                   const std::vector<char>& scan) {
+  const int s = grid.supersample, outWidth = grid.width / s, outHeight = grid.height / s;
+  auto covered = [&](int i, int j) { return mask.at(i, j) > 0.5f; };
+  std::vector<uint64_t> cells;
+  for (int y = 0; y < outHeight; ++y) {
+    for (int x = 0; x < outWidth; ++x) {
+      if (!scan[static_cast<size_t>(y) * outWidth + x]) continue;
+      for (int j = std::max(0, y * s - 1); j < std::min(grid.height - 1, y * s + s); ++j) {
+        for (int i = std::max(0, x * s - 1); i < std::min(grid.width - 1, x * s + s); ++i) {
+          bool a = covered(i, j);
+          if (covered(i + 1, j) != a || covered(i, j + 1) != a || covered(i + 1, j + 1) != a) {
+            cells.push_back(grid.sample(i, j));
+          }
+        }
+      }
+    }
+  }
+  sortUnique(cells);
+  return cells;
+}
+
 // Coverage of the corners of every cell, by the query (not the mask: the two may disagree at a
 // sample by rounding, and the crossings must bracket the query's own boundary).
 SortedMap<char> cornerCoverage(const std::vector<uint64_t>& cells, const SampleGrid& grid,
@@ -189,36 +214,80 @@ std::vector<Vec2> bisectEdges(const std::vector<uint64_t>& edges, const SampleGr
   return bisect(std::move(in), std::move(out), 1.0 / grid.supersample, query, cancel, tolerance);
 }
 
-// Moves the middle of every segment onto the outline: a search along the chord's perpendicular,
-// half a cell either way, splits the segment in two at the crossing found (a segment whose
-// perpendicular sees one coverage at both ends stays whole). This halves the chord's error on
-// curves and puts a point on a sharp corner that falls inside a cell, which a chord between two
-// cell edges would cut by up to 0.09 cell.
+// Segments next to a point where the polyline turns by more than kSharpTurnDeg, or that end at a
+// point not joined to exactly two segments. On a smooth outline the polyline turns by about
+// (cell / radius of curvature) per point, a few degrees, and its chords are already within
+// cell^2 / (8 radius) of the curve (under 1e-3 px at S = 4 for radii over 8 px).
+std::vector<size_t> segmentsAtSharpTurns(const Outline& outline) {
+  constexpr double kSharpTurnDeg = 15;
+  const double cosSharp = std::cos(kSharpTurnDeg * 3.14159265358979323846 / 180);
+  const size_t n = outline.segments.size();
+  std::vector<std::array<int, 2>> incident(outline.points.size(), {-1, -1});
+  std::vector<int> degree(outline.points.size(), 0);
+  for (size_t k = 0; k < n; ++k) {
+    for (int end : {outline.segments[k].first, outline.segments[k].second}) {
+      if (degree[end] < 2) incident[end][degree[end]] = static_cast<int>(k);
+      ++degree[end];
+    }
+  }
+  std::vector<char> sharp(n, 0);
+  for (size_t p = 0; p < outline.points.size(); ++p) {
+    if (degree[p] == 0) continue;
+    bool turns = degree[p] != 2;
+    if (!turns) {
+      auto other = [&](int segment) {
+        const auto& s = outline.segments[segment];
+        return outline.points[s.first == static_cast<int>(p) ? s.second : s.first];
+      };
+      Vec2 here = outline.points[p], a = other(incident[p][0]), b = other(incident[p][1]);
+      double ax = here.x - a.x, ay = here.y - a.y, bx = b.x - here.x, by = b.y - here.y;
+      double la = std::hypot(ax, ay), lb = std::hypot(bx, by);
+      turns = la > 0 && lb > 0 && (ax * bx + ay * by) < cosSharp * la * lb;
+    }
+    if (!turns) continue;
+    for (int segment : incident[p]) {
+      if (segment >= 0) sharp[segment] = 1;
+    }
+  }
+  std::vector<size_t> which;
+  for (size_t k = 0; k < n; ++k) {
+    if (sharp[k]) which.push_back(k);
+  }
+  return which;
+}
+
+// Moves the middle of every segment at a sharp turn onto the outline: a search along the
+// chord's perpendicular, half a cell either way, splits the segment in two at the crossing
+// found (a segment whose perpendicular sees one coverage at both ends stays whole). This puts a
+// point on a sharp corner that falls inside a cell, which a chord between two cell edges would
+// cut by up to 0.09 cell.
 void splitSegments(Outline& outline, double cell, const CoverageQuery& query,
                    const CancelToken& cancel, double tolerance) {
-  const size_t n = outline.segments.size();
+  const std::vector<size_t> candidates = segmentsAtSharpTurns(outline);
+  const size_t n = candidates.size();
   std::vector<Vec2> ends(2 * n);
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t c = 0; c < n; ++c) {
+    const size_t k = candidates[c];
     Vec2 a = outline.points[outline.segments[k].first];
     Vec2 b = outline.points[outline.segments[k].second];
     double dx = b.x - a.x, dy = b.y - a.y, len = std::hypot(dx, dy);
     Vec2 m{(a.x + b.x) / 2, (a.y + b.y) / 2};
     Vec2 normal = len > 0 ? Vec2{-dy / len, dx / len} : Vec2{0, 0};
-    ends[2 * k] = {m.x - normal.x * cell / 2, m.y - normal.y * cell / 2};
-    ends[2 * k + 1] = {m.x + normal.x * cell / 2, m.y + normal.y * cell / 2};
+    ends[2 * c] = {m.x - normal.x * cell / 2, m.y - normal.y * cell / 2};
+    ends[2 * c + 1] = {m.x + normal.x * cell / 2, m.y + normal.y * cell / 2};
   }
   std::vector<char> covered;
   query(ends, covered);
   std::vector<Vec2> in, out;
   std::vector<size_t> which;
-  for (size_t k = 0; k < n; ++k) {
-    if (covered[2 * k] == covered[2 * k + 1]) continue;
-    in.push_back(ends[2 * k + (covered[2 * k] ? 0 : 1)]);
-    out.push_back(ends[2 * k + (covered[2 * k] ? 1 : 0)]);
-    which.push_back(k);
+  for (size_t c = 0; c < n; ++c) {
+    if (covered[2 * c] == covered[2 * c + 1]) continue;
+    in.push_back(ends[2 * c + (covered[2 * c] ? 0 : 1)]);
+    out.push_back(ends[2 * c + (covered[2 * c] ? 1 : 0)]);
+    which.push_back(candidates[c]);
   }
   std::vector<Vec2> middles = bisect(std::move(in), std::move(out), cell, query, cancel, tolerance);
-  outline.segments.reserve(n + which.size());
+  outline.segments.reserve(outline.segments.size() + which.size());
   for (size_t i = 0; i < which.size(); ++i) {
     const int middle = static_cast<int>(outline.points.size());
     outline.points.push_back(middles[i]);
@@ -385,12 +454,17 @@ std::vector<double> directedDistances(const Outline& from, const SegmentIndex& i
 }  // namespace
 
 Outline locateOutline(const Image& mask, int supersample, const CoverageQuery& query,
-                      const CancelToken& cancel, double tolerancePx) {
+                      const CancelToken& cancel, const std::vector<char>* scan,
+                      double tolerancePx) {
   if (mask.channels != 1 || supersample < 1) {
     throw std::invalid_argument("locateOutline: a one-channel mask and a supersample >= 1");
   }
   SampleGrid grid{mask.width, mask.height, supersample};
-  std::vector<uint64_t> cells = mixedCells(mask, grid);
+  const size_t outputPixels =
+      static_cast<size_t>(mask.width / supersample) * (mask.height / supersample);
+  std::vector<uint64_t> cells = scan && scan->size() == outputPixels
+                                    ? mixedCellsIn(mask, grid, *scan)
+                                    : mixedCells(mask, grid);
   cancel.check();
   Outline outline;
   outline.frameWidth = static_cast<double>(mask.width) / supersample;

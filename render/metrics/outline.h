@@ -6,8 +6,8 @@
 // supersampled mask shows which cells of the sample grid the outline crosses; on every edge of
 // such a cell whose two samples differ, the crossing is found by bisection with a coverage
 // query on the geometry itself (a ray cast, not the mask), the crossings of each cell are
-// joined into segments as marching squares joins them, and each segment's middle is moved onto
-// the outline the same way (so sharp corners inside a cell are not cut off). See docs/engine.md "Continuous outline
+// joined into segments as marching squares joins them, and where the polyline turns sharply the
+// segments' middles are moved onto the outline the same way (so corners are not cut off). See docs/engine.md "Continuous outline
 // distances" for the definition, the image border and one-sided outlines.
 #pragma once
 
@@ -29,7 +29,7 @@ using CoverageQuery =
 
 struct Outline {
   std::vector<Vec2> points;             // located crossings, output pixels
-  std::vector<std::pair<int, int>> segments;  // indices into points, two per cell crossing
+  std::vector<std::pair<int, int>> segments;  // indices into points
   // The frame points are measured in: the rectangle of output pixel centres, [0.5, w - 0.5] x
   // [0.5, h - 0.5], which every supersampling's sample grid covers (a finer grid reaches closer
   // to the image border, and must not be counted as an outline the coarser one lacks).
@@ -43,8 +43,12 @@ inline constexpr double kOutlineTolerancePx = 1e-3;
 // The outline of a coverage mask at `supersample` times the output size (samples at the centres
 // of its pixels, covered above 0.5), located with `query`. Samples outside the mask are not
 // invented: the outline lies between sample centres, so the image frame is not part of it.
+// `scan` (optional, one flag per output pixel) limits the search to the cells in and along the
+// blocks of the flagged pixels: where the caller knows the mask can be mixed (the reference's
+// refined pixels); otherwise every cell of the mask is looked at.
 Outline locateOutline(const Image& supersampledMask, int supersample, const CoverageQuery& query,
-                      const CancelToken& cancel, double tolerancePx = kOutlineTolerancePx);
+                      const CancelToken& cancel, const std::vector<char>* scan = nullptr,
+                      double tolerancePx = kOutlineTolerancePx);
 
 struct OutlineDistances {
   double hausdorffPx = 0;  // max over both directions of the distance from a point to the other

@@ -121,24 +121,30 @@ std::vector<char> outlineCandidates(const ReferenceTessellation& tessellation, c
 // block is mixed or disagrees with the pixel.
 std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
                                  int width, int height, const Image* hint, int s) {
+  constexpr uint8_t kSomeUncovered = 1, kSomeCovered = 2;
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+    std::vector<uint8_t> hintBlocks(width);  // what each block of the hint holds, row by row
     for (int y = r.begin(); y < r.end(); ++y) {
+      if (hint) {
+        std::fill(hintBlocks.begin(), hintBlocks.end(), uint8_t{0});
+        for (int j = y * s; j < (y + 1) * s; ++j) {
+          const float* row = &hint->pixels[static_cast<size_t>(j) * hint->width];
+          for (int x = 0; x < width; ++x) {
+            uint8_t seen = 0;
+            for (int i = x * s; i < (x + 1) * s; ++i) seen |= row[i] > 0.5f ? kSomeCovered : kSomeUncovered;
+            hintBlocks[x] |= seen;
+          }
+        }
+      }
       for (int x = 0; x < width; ++x) {
         const size_t p = static_cast<size_t>(y) * width + x;
-        bool differs = false;
+        if (refine[p]) continue;
+        bool differs = hint && hintBlocks[x] != (covered[p] ? kSomeCovered : kSomeUncovered);
         for (int dy = -1; dy <= 1 && !differs; ++dy) {
           for (int dx = -1; dx <= 1 && !differs; ++dx) {
             int nx = x + dx, ny = y + dy;
             if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
             differs = covered[static_cast<size_t>(ny) * width + nx] != covered[p];
-          }
-        }
-        if (refine[p]) continue;
-        if (!differs && hint) {
-          for (int j = 0; j < s && !differs; ++j) {
-            for (int i = 0; i < s && !differs; ++i) {
-              differs = (hint->at(x * s + i, y * s + j) > 0.5f) != (covered[p] != 0);
-            }
           }
         }
         refine[p] = differs;
@@ -260,20 +266,22 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
     if (options.locateOutline) {
       start = Clock::now();
       result.outline = metrics::locateOutline(result.images.supersampledMask, s,
-                                              coverageQuery(scene, camera, cancel), cancel);
+                                              coverageQuery(scene, camera, cancel), cancel,
+                                              &refine);
       stats.outlineMs = msSince(start);
     }
+    result.refinedPixels = std::move(refine);
   }
   return result;
 }
 
 metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,
                                    const Image& supersampledMask, int supersample,
-                                   const CancelToken& cancel) {
+                                   const CancelToken& cancel, const std::vector<char>* scan) {
   EmbreeScene scene = buildTriangleScene(mesh, RTC_BUILD_QUALITY_LOW);
   cancel.check();
   return metrics::locateOutline(supersampledMask, supersample,
-                                coverageQuery(scene.get(), camera, cancel), cancel);
+                                coverageQuery(scene.get(), camera, cancel), cancel, scan);
 }
 
 }  // namespace limn::render::oracle

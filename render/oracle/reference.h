@@ -43,6 +43,9 @@ struct ReferenceStats {
 struct ReferenceResult {
   ImageSet images;
   metrics::Outline outline;  // when asked for (ReferenceOptions::locateOutline)
+  // Per output pixel: its S x S mask samples were all cast (elsewhere the mask is uniform over
+  // the pixel's block and equal to its neighbours'): where outlines can be, for locateOutline.
+  std::vector<char> refinedPixels;
   ReferenceStats stats;
   std::vector<std::string> warnings;
 };
@@ -79,9 +82,12 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 // The outline of any triangle mesh (an approximation) seen by `camera`, located to sub-pixel
 // precision by rays against its own triangles; `supersampledMask` (its coverage at S times the
 // size, e.g. from the rasteriser) says where to look.
+// `scan`: the reference's refinedPixels when that reference was hinted with this mask (then they
+// hold every place this mask can be mixed), or null to look everywhere.
 metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,
                                    const Image& supersampledMask, int supersample,
-                                   const CancelToken& cancel);
+                                   const CancelToken& cancel,
+                                   const std::vector<char>* scan = nullptr);
 
 // The independent check (Catmull-Clark only): Embree's RTC_GEOMETRY_TYPE_SUBDIVISION with the
 // mesh's creases and corners, cast at `camera` (pass the supersampled one); returns its coverage

@@ -270,8 +270,9 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       const ImageSet& refImages = reference.images;
       result.metrics.silhouette = metrics::compareSilhouettes(
           approxImages.supersampledMask, refImages.supersampledMask, S);
-      metrics::Outline outline =
-          oracle::locateMeshOutline(*approx, camera, approxImages.supersampledMask, S, cancel);
+      // The reference was hinted with this mask: its refined pixels hold all of its outline.
+      metrics::Outline outline = oracle::locateMeshOutline(
+          *approx, camera, approxImages.supersampledMask, S, cancel, &reference.refinedPixels);
       metrics::OutlineDistances d = metrics::compareOutlines(
           outline, reference.outline, std::hypot(camera.width(), camera.height()));
       result.metrics.silhouette->outlineHausdorffPx = d.hausdorffPx;

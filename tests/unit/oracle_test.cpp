@@ -426,10 +426,10 @@ TEST(Reference, HintMakesTheMaskExactWhereTheHintHasAnOutline) {
 }
 
 // The reference's continuous outline located from masks at S = 4 and S = 8 agrees within
-// `hausdorffPx` (and 0.002 px on average).
+// `hausdorffPx` and `meanPx`.
 void expectOutlinesAgreeAcrossSupersampling(const subdiv::LimitSurface& surface,
                                             const Camera& camera, const std::string& name,
-                                            double hausdorffPx = 0.05) {
+                                            double hausdorffPx = 0.05, double meanPx = 0.002) {
   ReferenceOptions options{.locateOutline = true};
   ReferenceResult r4 = renderReference(surface, camera, PassSelection{.supersample = 4}, {}, options);
   ReferenceResult r8 = renderReference(surface, camera, PassSelection{.supersample = 8}, {}, options);
@@ -438,7 +438,7 @@ void expectOutlinesAgreeAcrossSupersampling(const subdiv::LimitSurface& surface,
             << " px, mean " << d.meanPx << " px, " << r4.outline.points.size() << " / "
             << r8.outline.points.size() << " points\n";
   EXPECT_LE(d.hausdorffPx, hausdorffPx) << name;
-  EXPECT_LE(d.meanPx, 0.002) << name;
+  EXPECT_LE(d.meanPx, meanPx) << name;
   EXPECT_FALSE(r4.outline.empty()) << name;
 }
 
@@ -724,10 +724,10 @@ TEST(Corpus, OutlineAgreesAcrossSupersampling) {
     }
     // Wedge tips, slivers and T-junctions of the outline narrower than a quarter pixel are
     // resolved further at S = 8 than at S = 4 (docs/engine.md): the maximum is bounded by 0.75 px
-    // there, not 0.05 px as on outlines without such features.
+    // there, not 0.05 px as on outlines without such features, and the mean by 0.004 px.
     Camera camera = viewOf(*surface, 128, Vec3{0.3, 0.45, 0.85} * surface->bounds().diagonal());
     expectOutlinesAgreeAcrossSupersampling(*surface, camera, entry.path().filename().string(),
-                                           0.75);
+                                           0.75, 0.004);
     ++compared;
   }
   EXPECT_GT(compared, 30);
