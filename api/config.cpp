@@ -99,6 +99,7 @@ void readLimits(const Value& object, const std::string& source,
   r.integer("maxVertices", limits.mesh.maxVertices, 1);
   r.integer("maxFaces", limits.mesh.maxFaces, 1);
   r.integer("maxFaceSize", limits.mesh.maxFaceSize, 3);
+  r.integer("maxValence", limits.mesh.maxValence, 3);
   r.integer("maxImageSide", limits.maxImageSide, 1);
   r.integer("maxSupersample", limits.maxSupersample, 1);
   r.integer("maxLevel", limits.maxLevel, 0);

@@ -31,6 +31,22 @@ void checkSharpness(float s, const std::string& subject) {
                                                        ": must be finite and >= 0");
 }
 
+// The number of face corners at each vertex (its valence on a closed manifold) against the
+// limit: the limit surface around a vertex of valence n costs about n^3 to build (OpenSubdiv's
+// patch of every face around it has O(n) points of O(n) weights each), so a small mesh with one
+// vertex of very high valence could hold a worker for minutes.
+void checkValence(const ControlMesh& mesh, int maxValence) {
+  std::vector<int> corners(mesh.points.size(), 0);
+  for (int v : mesh.faceVertexIndices) ++corners[v];
+  for (size_t v = 0; v < corners.size(); ++v) {
+    if (corners[v] <= maxValence) continue;
+    const std::string vertex = "vertex " + std::to_string(v);
+    invalid(vertex, vertex + " has " + std::to_string(corners[v]) +
+                        " faces around it: exceeds limit maxValence (" +
+                        std::to_string(maxValence) + ")");
+  }
+}
+
 }  // namespace
 
 Bounds ControlMesh::bounds() const {
@@ -104,6 +120,7 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
                                      " entries but faceVertexCounts sums to " +
                                      std::to_string(offset));
   }
+  checkValence(mesh, limits.maxValence);
 
   for (size_t c = 0; c < mesh.creases.size(); ++c) {
     const Crease& crease = mesh.creases[c];

@@ -50,10 +50,11 @@ struct MeshLimits {
   int maxVertices = 200000;
   int maxFaces = 200000;
   int maxFaceSize = 64;  // vertices in one face
+  int maxValence = 512;  // faces around one vertex (422 naming the vertex beyond it)
 };
 
-// Throws InputError (InvalidMesh naming the face, vertex, crease or corner; LimitExceeded naming
-// the limit) when the mesh cannot be used.
+// Throws InputError (InvalidMesh naming the face, vertex, crease or corner — also for a vertex
+// over maxValence; LimitExceeded naming the limit) when the mesh cannot be used.
 void validateMesh(const ControlMesh& mesh, const MeshLimits& limits);
 
 const char* schemeName(Scheme scheme);

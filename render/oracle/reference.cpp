@@ -185,6 +185,12 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
     stats.tessellateMs = built->tessellateMs;
     stats.bvhMs = built->bvhMs;
   }
+  if (tessellation.ratesScaled < 1) {
+    result.warnings.push_back(
+        "reference: tessellation rates scaled by " + std::to_string(tessellation.ratesScaled) +
+        " to stay within " + std::to_string(static_cast<long>(4 * kReferenceTriangleBudget)) +
+        " triangles; the reference's outline is less exact than usual");
+  }
   if (tessellation.outlineErrorPx > kOutlineChordErrorPx * 1.0001) {
     result.warnings.push_back(
         "reference: outline chord error raised to " + std::to_string(tessellation.outlineErrorPx) +

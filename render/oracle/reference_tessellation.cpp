@@ -126,6 +126,9 @@ ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface
   options.maxEdgeRate = kReferenceMaxEdgeRate;
   options.minEdgeRate = 1;
   options.maxTriangles = 4 * static_cast<size_t>(kReferenceTriangleBudget);
+  options.fitToBudget = true;
+  options.stage = "reference";
+  options.ratesScaled = &result.ratesScaled;
   options.minSegments = [&segments](int edge) { return segments[edge]; };
   result.mesh = tessellate::tessellateAdaptive(surface, camera, options, cancel);
   return result;

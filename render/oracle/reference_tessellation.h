@@ -43,6 +43,9 @@ struct ReferenceTessellation {
   // Per control face: it borders a boundary, a hole or a face without limit surface, so its
   // outline can run along its edges whatever the facing (the reference's mask refines there).
   std::vector<char> borderFaces;
+  // 1, or the factor every edge rate was scaled by to stay within 4x the budget when the
+  // estimate fell short (the outline error grows as its inverse square).
+  double ratesScaled = 1;
 };
 
 // `camera` is the output camera (not the supersampled one).

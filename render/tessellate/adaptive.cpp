@@ -6,9 +6,11 @@
 // 2. Every edge gets one rate: the largest its faces ask for, a face asking for its edge's
 //    projected length (along the limit curve's corner-midpoint-corner polyline) divided by the
 //    dicing rate; callers may raise any edge's count (AdaptiveOptions::minSegments).
-// 3. Faces are tessellated independently (Bfr::Tessellation with those edge rates) and
+// 3. The triangles those rates make are counted (Bfr::Tessellation, nothing evaluated) and
+//    checked against maxTriangles before any memory is spent on them.
+// 4. Faces are tessellated independently (Bfr::Tessellation with those edge rates) and
 //    evaluated in parallel.
-// 4. Assembly shares the points of each edge between its faces, so the mesh is watertight by
+// 5. Assembly shares the points of each edge between its faces, so the mesh is watertight by
 //    construction; a shared point gets a second vertex (same position) only where the faces'
 //    normals disagree, as across an infinitely sharp crease.
 #include <opensubdiv/bfr/tessellation.h>
@@ -96,6 +98,56 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
     }
   }
   return probe;
+}
+
+// Triangles the faces make with these edge rates (Bfr counts them without evaluating).
+size_t countTriangles(const subdiv::LimitSurface& surface, const std::vector<int>& edgeRate) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  std::vector<size_t> perFace(surface.faceCount(), 0);
+  parallelFor(perFace.size(), 256, [&](size_t begin, size_t end) {
+    std::vector<int> rates;
+    for (size_t f = begin; f < end; ++f) {
+      if (!surface.hasLimit(static_cast<int>(f))) continue;
+      Far::ConstIndexArray edges = base.GetFaceEdges(static_cast<int>(f));
+      rates.resize(edges.size());
+      for (int k = 0; k < edges.size(); ++k) rates[k] = edgeRate[edges[k]];
+      Bfr::Parameterization param = surface.parameterization(static_cast<int>(f));
+      perFace[f] = Bfr::Tessellation(param, param.GetFaceSize(), rates.data()).GetNumFacets();
+    }
+  });
+  size_t total = 0;
+  for (size_t n : perFace) total += n;
+  return total;
+}
+
+// Throws when the rates make more than maxTriangles, or with fitToBudget scales them down by
+// the square root of the excess (triangles grow as the square of the rates) until they fit.
+void keepToTriangleBudget(const subdiv::LimitSurface& surface, const AdaptiveOptions& options,
+                          std::vector<int>& edgeRate, const CancelToken& cancel) {
+  size_t triangles = countTriangles(surface, edgeRate);
+  double scaled = 1;
+  while (triangles > options.maxTriangles) {
+    if (!options.fitToBudget) {
+      throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
+                       std::string(options.stage) + " tessellation would make " +
+                           std::to_string(triangles) + " triangles: exceeds limit maxTriangles " +
+                           std::to_string(options.maxTriangles) +
+                           (std::string(options.stage) == "adaptive" ? " (raise params.dicingRate)"
+                                                                     : ""));
+    }
+    cancel.check();
+    double factor = std::sqrt(static_cast<double>(options.maxTriangles) / triangles) * 0.95;
+    bool changed = false;
+    for (int& rate : edgeRate) {
+      int lower = std::max(options.minEdgeRate, static_cast<int>(std::floor(rate * factor)));
+      changed |= lower != rate;
+      rate = lower;
+    }
+    scaled *= factor;
+    if (!changed) break;  // every edge at its smallest rate: the mesh itself is the budget
+    triangles = countTriangles(surface, edgeRate);
+  }
+  if (options.ratesScaled) *options.ratesScaled = scaled;
 }
 
 FacePatch tessellateFace(const subdiv::LimitSurface& surface, int face, const int* rates) {
@@ -196,7 +248,10 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
     }
   }
 
-  // 3. Tessellate and evaluate every face.
+  // 3. Count the triangles those rates make, before evaluating anything, and keep to the budget.
+  keepToTriangleBudget(surface, options, edgeRate, cancel);
+
+  // 4. Tessellate and evaluate every face.
   std::vector<FacePatch> patches(faceCount);
   parallelFor(faceCount, 16, [&](size_t begin, size_t end) {
     cancel.check();
@@ -211,15 +266,9 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
   });
   size_t triangles = 0;
   for (const FacePatch& p : patches) triangles += p.facets.size() / 3;
-  if (triangles > options.maxTriangles) {
-    throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
-                     "adaptive tessellation would make " + std::to_string(triangles) +
-                         " triangles: exceeds limit maxTriangles " +
-                         std::to_string(options.maxTriangles) + " (raise dicingRate)");
-  }
   cancel.check();
 
-  // 4. Assemble. Shared points: mesh vertices first, then each edge's interior points.
+  // 5. Assemble. Shared points: mesh vertices first, then each edge's interior points.
   std::vector<size_t> edgeFirstPoint(base.GetNumEdges());
   size_t pointCount = static_cast<size_t>(surface.mesh().vertexCount());
   for (int e = 0; e < base.GetNumEdges(); ++e) {

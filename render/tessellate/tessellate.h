@@ -44,6 +44,13 @@ struct AdaptiveOptions {
   int maxEdgeRate = 128;    // segments per edge at most
   int minEdgeRate = 1;      // used for faces outside the view or facing away
   size_t maxTriangles = 8'000'000;
+  // Over maxTriangles (counted from the edge rates before anything is evaluated): false throws
+  // LimitExceeded naming `stage`; true scales every rate down until the mesh fits (the
+  // reference's own tessellation, which must not refuse what a method can draw) and reports the
+  // factor in *ratesScaled.
+  bool fitToBudget = false;
+  const char* stage = "adaptive";
+  double* ratesScaled = nullptr;
   // Optional lower bound on the segments of base-level edge e (then capped by maxEdgeRate),
   // applied whether or not its faces are culled. Projected lengths are foreshortened where the
   // surface turns away at the silhouette; the reference bounds those edges by their 3D length.

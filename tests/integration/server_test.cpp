@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <map>
 #include <memory>
@@ -178,6 +179,40 @@ TEST_F(ServerTest, SecondReferenceForTheSameViewComesFromTheCache) {
             std::string::npos);
   EXPECT_EQ(metrics.body.find("limn_reference_cache_lookups_total{result=\"hit\"} 0\n"),
             std::string::npos);
+}
+
+// A flat fan of n Loop triangles around one vertex (valence n), as a JSON-ready OBJ string.
+std::string fanObj(int n) {
+  std::string obj = "v 0 0 0\\n";
+  for (int k = 0; k < n; ++k) {
+    double a = 2 * 3.14159265358979 * k / n;
+    obj += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\\n";
+  }
+  for (int k = 0; k < n; ++k) {
+    obj += "f 1 " + std::to_string(k + 2) + " " + std::to_string((k + 1) % n + 2) + "\\n";
+  }
+  return obj;
+}
+
+// High valence: over limits.maxValence a quick 422 names the vertex and the limit (building the
+// limit surface around it would take minutes); under it, every method and the reference answer.
+TEST_F(ServerTest, HighValenceIsRefusedByNameOrRendered) {
+  auto body = [](int n, const char* method) {
+    return R"({"mesh": {"format": "obj", "scheme": "loop", "data": ")" + fanObj(n) +
+           R"("}, "camera": {"width": 128, "height": 128, "eye": [0.3, 0.4, 3]}, "method": ")" +
+           method + R"(", "reference": true})";
+  };
+  auto start = std::chrono::steady_clock::now();
+  HttpResponse refused = post(port(), "/v1/render", body(5000, "coarse"));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  EXPECT_EQ(refused.status, 422) << refused.body.substr(0, 300);
+  EXPECT_EQ(errorCode(refused), "invalid_mesh");
+  EXPECT_NE(refused.body.find("vertex 0"), std::string::npos) << refused.body;
+  EXPECT_NE(refused.body.find("maxValence"), std::string::npos) << refused.body;
+  for (const char* method : {"coarse", "adaptive", "silhouette"}) {
+    HttpResponse ok = post(port(), "/v1/render", body(200, method));
+    EXPECT_EQ(ok.status, 200) << method << ": " << ok.body.substr(0, 300);
+  }
 }
 
 // The silhouette method through the server: exact outline on the cube, its counts, the

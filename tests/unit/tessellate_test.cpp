@@ -234,7 +234,39 @@ TEST(Adaptive, RespectsTheTriangleLimit) {
   AdaptiveOptions options;
   options.dicingRate = 0.5;
   options.maxTriangles = 1000;
-  EXPECT_THROW(tessellateAdaptive(surface, camera, options, CancelToken()), InputError);
+  try {
+    tessellateAdaptive(surface, camera, options, CancelToken());
+    ADD_FAILURE() << "no LimitExceeded";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.subject(), "maxTriangles");
+    EXPECT_NE(std::string(e.what()).find("adaptive tessellation would make"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("dicingRate"), std::string::npos) << e.what();
+  }
+  // Another stage's name is the one the message gives.
+  options.stage = "reference";
+  try {
+    tessellateAdaptive(surface, camera, options, CancelToken());
+    ADD_FAILURE() << "no LimitExceeded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reference tessellation"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Adaptive, FitToBudgetScalesTheRatesDownInsteadOfRefusing) {
+  subdiv::LimitSurface surface(testing::torus());
+  Camera camera = frontCamera(surface, 1024);
+  AdaptiveOptions options;
+  options.dicingRate = 0.5;
+  options.maxTriangles = 20000;
+  options.fitToBudget = true;
+  double scaled = 0;
+  options.ratesScaled = &scaled;
+  TriangleMesh mesh = tessellateAdaptive(surface, camera, options, CancelToken());
+  EXPECT_LE(mesh.triangleCount(), 20000u);
+  EXPECT_GT(mesh.triangleCount(), 5000u);
+  EXPECT_LT(scaled, 1.0);
+  EXPECT_GT(scaled, 0.0);
 }
 
 }  // namespace
