@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("\n## Reference and metrics (adaptive dr1 with reference: true, S = 4)\n\n");
+  std::printf("\n## Reference and metrics (adaptive dr1 with reference: true, S = 4, "
+              "referenceCrossCheck: true)\n\n");
   std::printf("| mesh | size | reference triangles | reference ms | metrics ms | total ms | "
               "hausdorffPx | crossCheckPx |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -155,6 +156,7 @@ int main(int argc, char** argv) {
       job.camera.height = size;
       job.method = Method::Adaptive;
       job.reference = true;
+      job.params.referenceCrossCheck = true;
       try {
         auto r = runBest(job, context, std::max(1, config.repeat / 2));
         std::string cross = r.stats.referenceCrossCheckPx

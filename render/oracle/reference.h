@@ -95,7 +95,8 @@ metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const C
 // OpenSubdiv defines it: Loop or bilinear schemes, Chaikin creases, smooth triangle subdivision,
 // faces over 15 vertices, non-manifold topology, and two crease configurations where Embree's
 // rules were measured to differ from Far's limit by 2-15% of the model size (creases of
-// different sharpness meeting at a vertex with one of them semi-sharp; semi-sharp corners).
+// different sharpness meeting at a vertex with one of them semi-sharp; semi-sharp corners),
+// and interior vertices of valence 2.
 // Holes and the faces boundary None removes stay in Embree's mesh (they support their
 // neighbours, as in OpenSubdiv) and are skipped by a filter; boundary modes map to Embree's
 // smooth boundary or pinned corners. Embree's grid is uniform over the mesh, sized from the

@@ -306,14 +306,8 @@ TEST_P(EveryShape, ErrorsAgainstTheReference) {
   RecordProperty("adaptiveHausdorffPx", std::to_string(adaptivePx));
   // The two reference paths agree to one supersampled pixel (the finest step a mask
   // Hausdorff distance has: 0.25 px at S = 4) and on average to a hundredth of a pixel.
-  // Known exceptions: on catmark_gregory_test1 and around own_val2_grid's lifted valence-2
-  // vertex Embree's own subdivision surface departs from OpenSubdiv's (the server warns; on the
-  // latter by 234 px, while Far's uniform level 4, pushed to the limit by PrimvarRefiner and
-  // independent of the patches, is within 0.25 px of the reference). The reference is
-  // OpenSubdiv's.
   const rapidjson::Value& stats = adaptive->body["stats"];
-  if (stats.HasMember("referenceCrossCheckPx") && shape.name != "catmark_gregory_test1" &&
-      shape.name != "own_val2_grid") {
+  if (stats.HasMember("referenceCrossCheckPx")) {
     EXPECT_LE(stats["referenceCrossCheckPx"].GetDouble(), 0.25) << "two references disagree";
     EXPECT_LE(stats["referenceCrossCheckMeanPx"].GetDouble(), 0.01) << "two references disagree";
   }
