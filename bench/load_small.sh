@@ -24,5 +24,5 @@ JSON
 curl -sf -X POST --data-binary @"$body" "127.0.0.1:$port/v1/render" | python3 -c \
   'import json,sys; t=json.load(sys.stdin)["timings"]; print("one request:", {k: round(v, 2) for k, v in t.items() if isinstance(v, float)})'
 hey -z "$duration" -c "$clients" -m POST -T application/json -D "$body" \
-  "http://127.0.0.1:$port/v1/render" | sed -n '/Summary/,/Status code distribution/p;/\[[0-9]*\]/p'
+  "http://127.0.0.1:$port/v1/render" | grep -v '|' | grep -v '^ *$'
 rm -f "$body"
