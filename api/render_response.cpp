@@ -160,6 +160,11 @@ void writeStats(Writer& w, const render::pipeline::Stats& s) {
   if (s.referenceCrossCheckPx) {
     numberField(w, "referenceCrossCheckPx", *s.referenceCrossCheckPx);
     numberField(w, "referenceCrossCheckMeanPx", s.referenceCrossCheckMeanPx.value_or(0.0));
+    if (s.referenceCrossCheckOutlinePx) {
+      numberField(w, "referenceCrossCheckOutlinePx", *s.referenceCrossCheckOutlinePx);
+      numberField(w, "referenceCrossCheckOutlineMeanPx",
+                  s.referenceCrossCheckOutlineMeanPx.value_or(0.0));
+    }
   }
   if (s.silhouette) writeSilhouetteStats(w, *s.silhouette, s.presubdivided);
   w.EndObject();

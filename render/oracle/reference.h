@@ -104,8 +104,13 @@ metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const C
 // agreement with the reference on the corpus: at most one supersampled pixel apart, mean
 // 0.0002-0.004 output px; Embree is off by about 3e-4 of the model size near infinitely sharp
 // crease ends and cuts infinitely sharp corner tips short by a pixel or two.
+//
+// With `outline`, also locates the outline of Embree's surface to sub-pixel precision (rays on
+// its own scene): `camera` must then be an output camera scaled by `supersample`, and the
+// outline is in that output camera's pixels.
 std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
                                            const Camera& camera, const CancelToken& cancel,
-                                           std::string* whyNot);
+                                           std::string* whyNot, int supersample = 1,
+                                           metrics::Outline* outline = nullptr);
 
 }  // namespace limn::render::oracle

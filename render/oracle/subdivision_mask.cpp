@@ -234,7 +234,8 @@ T* newBuffer(RTCGeometry g, RTCBufferType type, RTCFormat format, size_t count) 
 
 std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
                                            const Camera& camera, const CancelToken& cancel,
-                                           std::string* whyNot) {
+                                           std::string* whyNot, int supersample,
+                                           metrics::Outline* outline) {
   auto refuse = [&](std::string reason) -> std::optional<Image> {
     if (whyNot) *whyNot = std::move(reason);
     return std::nullopt;
@@ -317,6 +318,17 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
   cancel.check();
   Image mask = castCoverage(scene.get(), camera, RayPacking::Packet16, cancel);
   closeCracks(scene.get(), camera, mask);
+  if (outline) {
+    // The outline's points are in output pixels; the rays go through the same points of the
+    // supersampled camera.
+    const double s = supersample;
+    auto query = [&](const std::vector<Vec2>& points, std::vector<char>& covered) {
+      std::vector<Vec2> fine(points.size());
+      for (size_t k = 0; k < points.size(); ++k) fine[k] = {points[k].x * s, points[k].y * s};
+      castCoverageAt(scene.get(), camera, fine, covered, cancel);
+    };
+    *outline = metrics::locateOutline(mask, supersample, query, cancel);
+  }
   return mask;
 }
 

@@ -85,6 +85,8 @@ struct Stats {
   // Quantised to 1/metricSupersample: a single differing supersampled pixel reads 1/S.
   std::optional<double> referenceCrossCheckPx;
   std::optional<double> referenceCrossCheckMeanPx;  // mean outline distance of the same pair
+  // The same pair's continuous outline distances (metrics/outline.h), not quantised.
+  std::optional<double> referenceCrossCheckOutlinePx, referenceCrossCheckOutlineMeanPx;
   // The silhouette method's own counts (absent for other methods).
   std::optional<silhouette::SilhouetteStats> silhouette;
   bool presubdivided = false;

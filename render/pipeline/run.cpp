@@ -148,16 +148,18 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
 // reference's supersampled mask; the agreement goes into stats, a disagreement over a pixel or a
 // reason it could not run into the warnings.
 void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& camera, int S,
-                         const Image& referenceMask, const CancelToken& cancel,
+                         const oracle::ReferenceResult& reference, const CancelToken& cancel,
                          RenderResult& result) {
+  const Image& referenceMask = reference.images.supersampledMask;
   if (surface.mesh().scheme != mesh::Scheme::CatmullClark) {
     result.warnings.push_back("reference cross-check skipped: Embree's subdivision geometry is "
                               "Catmull-Clark only");
     return;
   }
   std::string whyNot;
+  metrics::Outline embreeOutline;
   std::optional<Image> embreeMask =
-      oracle::embreeSubdivisionMask(surface, camera.scaled(S), cancel, &whyNot);
+      oracle::embreeSubdivisionMask(surface, camera.scaled(S), cancel, &whyNot, S, &embreeOutline);
   if (!embreeMask) {
     result.warnings.push_back("reference cross-check skipped: " + whyNot);
     return;
@@ -165,6 +167,10 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
   metrics::SilhouetteMetrics agreement = metrics::compareSilhouettes(*embreeMask, referenceMask, S);
   result.stats.referenceCrossCheckPx = agreement.hausdorffPx;
   result.stats.referenceCrossCheckMeanPx = agreement.meanPx;
+  metrics::OutlineDistances outline = metrics::compareOutlines(
+      embreeOutline, reference.outline, std::hypot(camera.width(), camera.height()));
+  result.stats.referenceCrossCheckOutlinePx = outline.hausdorffPx;
+  result.stats.referenceCrossCheckOutlineMeanPx = outline.meanPx;
   if (agreement.hausdorffPx > 1.0) {
     result.warnings.push_back("the two reference paths disagree: Embree's subdivision geometry is " +
                               std::to_string(agreement.hausdorffPx) +
@@ -259,7 +265,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     result.timings.reference = reference.stats;
     if (measure && job.params.referenceCrossCheck) {
       Stopwatch crossCheck;
-      crossCheckReference(surface, camera, S, reference.images.supersampledMask, cancel, result);
+      crossCheckReference(surface, camera, S, reference, cancel, result);
       result.timings.crossCheckMs = crossCheck.lapMs();
     }
     result.timings.referenceMs = clock.lapMs();

@@ -692,9 +692,16 @@ TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
       std::cout << "[ corpus   ] " << name << ": no cross-check: " << whyNot << "\n";
       continue;
     }
-    ReferenceResult r = renderReference(*surface, camera, allPasses(S), {});
+    ReferenceResult r = renderReference(*surface, camera, allPasses(S), {}, {.locateOutline = true});
     metrics::SilhouetteMetrics sm =
         metrics::compareSilhouettes(*embree, r.images.supersampledMask, S);
+    metrics::Outline embreeOutline;
+    embreeSubdivisionMask(*surface, camera.scaled(S), {}, &whyNot, S, &embreeOutline);
+    metrics::OutlineDistances od = metrics::compareOutlines(embreeOutline, r.outline, 1e9);
+    std::cout << "[ corpus   ] " << name << ": continuous " << od.hausdorffPx << " px, mean "
+              << od.meanPx << " px\n";
+    // As curves, the two paths agree far below the mask's quantum.
+    EXPECT_LE(od.hausdorffPx, 0.05) << name;
     std::cout << "[ corpus   ] " << name << ": hausdorff " << sm.hausdorffPx << " px, mean "
               << sm.meanPx << " px, triangles " << r.stats.triangles << ", newton failures "
               << r.stats.newtonFailures << "/" << r.stats.hits << "\n";
