@@ -11,20 +11,16 @@
 // reference cache (the same request again).
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "bench/bench_inputs.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
 #include "tests/unit/test_meshes.h"
 
-namespace fs = std::filesystem;
 using namespace limn;
 using render::pipeline::Method;
 using render::pipeline::RenderJob;
@@ -46,13 +42,6 @@ struct Config {
   std::vector<std::string> shapes;
 };
 
-std::vector<std::string> splitList(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
-  return out;
-}
-
 std::vector<NamedMesh> loadMeshes(const Config& config) {
   std::vector<NamedMesh> meshes = {
       {"pawn (own, 560 faces)", testing::pawn()},
@@ -60,15 +49,7 @@ std::vector<NamedMesh> loadMeshes(const Config& config) {
       {"bumpy ball (own, 1536 faces)", testing::bumpyBall(16)},
   };
   for (const std::string& shape : config.shapes) {
-    fs::path path = fs::path(config.corpus) / (shape + ".obj");
-    std::ifstream file(path);
-    if (!file) continue;
-    std::stringstream text;
-    text << file.rdbuf();
-    auto scheme = shape.rfind("loop_", 0) == 0       ? render::mesh::Scheme::Loop
-                  : shape.rfind("bilinear_", 0) == 0 ? render::mesh::Scheme::Bilinear
-                                                     : render::mesh::Scheme::CatmullClark;
-    meshes.push_back({shape, api::readObj(text.str(), scheme, {}).mesh});
+    if (auto mesh = bench::readShape(config.corpus, shape)) meshes.push_back({shape, *mesh});
   }
   return meshes;
 }
@@ -118,7 +99,7 @@ int main(int argc, char** argv) {
     else if (flag == "--supersample") config.supersample = std::stoi(value);
     else if (flag == "--repeat") config.repeat = std::stoi(value);
     else if (flag == "--corpus") config.corpus = value;
-    else if (flag == "--shapes") config.shapes = splitList(value);
+    else if (flag == "--shapes") config.shapes = bench::splitList(value);
     else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;

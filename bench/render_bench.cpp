@@ -6,19 +6,16 @@
 //   render_bench [--sizes 512,1024] [--repeat 3] [--corpus DIR] [--shapes a,b,...]
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <thread>
 #include <string>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "bench/bench_inputs.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
 #include "tests/unit/test_meshes.h"
 
-namespace fs = std::filesystem;
 using namespace limn;
 using render::pipeline::Method;
 
@@ -44,13 +41,6 @@ std::vector<int> parseInts(const std::string& list) {
   return out;
 }
 
-std::vector<std::string> parseNames(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
-  return out;
-}
-
 std::vector<NamedMesh> loadMeshes(const Config& config) {
   std::vector<NamedMesh> meshes = {
       {"cube (own)", testing::cube()},
@@ -59,15 +49,7 @@ std::vector<NamedMesh> loadMeshes(const Config& config) {
       {"icosahedron loop (own)", testing::icosahedron()},
   };
   for (const std::string& shape : config.shapes) {
-    fs::path path = fs::path(config.corpus) / (shape + ".obj");
-    if (!fs::exists(path)) continue;
-    std::ifstream file(path);
-    std::stringstream text;
-    text << file.rdbuf();
-    auto scheme = shape.rfind("loop_", 0) == 0       ? render::mesh::Scheme::Loop
-                  : shape.rfind("bilinear_", 0) == 0 ? render::mesh::Scheme::Bilinear
-                                                     : render::mesh::Scheme::CatmullClark;
-    meshes.push_back({shape, api::readObj(text.str(), scheme, {}).mesh});
+    if (auto mesh = bench::readShape(config.corpus, shape)) meshes.push_back({shape, *mesh});
   }
   return meshes;
 }
@@ -98,7 +80,7 @@ int main(int argc, char** argv) {
     if (flag == "--sizes") config.sizes = parseInts(value);
     else if (flag == "--repeat") config.repeat = std::stoi(value);
     else if (flag == "--corpus") config.corpus = value;
-    else if (flag == "--shapes") config.shapes = parseNames(value);
+    else if (flag == "--shapes") config.shapes = bench::splitList(value);
     else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;

@@ -100,20 +100,33 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
   return probe;
 }
 
-// Triangles the faces make with these edge rates (Bfr counts them without evaluating).
-size_t countTriangles(const subdiv::LimitSurface& surface, const std::vector<int>& edgeRate) {
+// Runs fn(face, rates) on all threads for every face with a limit surface, `rates` holding the
+// face's edge rates in its edge order.
+template <typename Fn>
+void forEachFaceWithRates(const subdiv::LimitSurface& surface, const std::vector<int>& edgeRate,
+                          size_t grain, const CancelToken& cancel, const Fn& fn) {
   const Far::TopologyLevel& base = surface.baseLevel();
-  std::vector<size_t> perFace(surface.faceCount(), 0);
-  parallelFor(perFace.size(), 256, [&](size_t begin, size_t end) {
+  parallelFor(surface.faceCount(), grain, [&](size_t begin, size_t end) {
+    cancel.check();
     std::vector<int> rates;
     for (size_t f = begin; f < end; ++f) {
-      if (!surface.hasLimit(static_cast<int>(f))) continue;
-      Far::ConstIndexArray edges = base.GetFaceEdges(static_cast<int>(f));
+      const int face = static_cast<int>(f);
+      if (!surface.hasLimit(face)) continue;
+      Far::ConstIndexArray edges = base.GetFaceEdges(face);
       rates.resize(edges.size());
       for (int k = 0; k < edges.size(); ++k) rates[k] = edgeRate[edges[k]];
-      Bfr::Parameterization param = surface.parameterization(static_cast<int>(f));
-      perFace[f] = Bfr::Tessellation(param, param.GetFaceSize(), rates.data()).GetNumFacets();
+      fn(face, rates.data());
     }
+  });
+}
+
+// Triangles the faces make with these edge rates (Bfr counts them without evaluating).
+size_t countTriangles(const subdiv::LimitSurface& surface, const std::vector<int>& edgeRate,
+                      const CancelToken& cancel) {
+  std::vector<size_t> perFace(surface.faceCount(), 0);
+  forEachFaceWithRates(surface, edgeRate, 256, cancel, [&](int face, const int* rates) {
+    Bfr::Parameterization param = surface.parameterization(face);
+    perFace[face] = Bfr::Tessellation(param, param.GetFaceSize(), rates).GetNumFacets();
   });
   size_t total = 0;
   for (size_t n : perFace) total += n;
@@ -124,7 +137,7 @@ size_t countTriangles(const subdiv::LimitSurface& surface, const std::vector<int
 // the square root of the excess (triangles grow as the square of the rates) until they fit.
 void keepToTriangleBudget(const subdiv::LimitSurface& surface, const AdaptiveOptions& options,
                           std::vector<int>& edgeRate, const CancelToken& cancel) {
-  size_t triangles = countTriangles(surface, edgeRate);
+  size_t triangles = countTriangles(surface, edgeRate, cancel);
   double scaled = 1;
   while (triangles > options.maxTriangles) {
     if (!options.fitToBudget) {
@@ -145,7 +158,7 @@ void keepToTriangleBudget(const subdiv::LimitSurface& surface, const AdaptiveOpt
     }
     scaled *= factor;
     if (!changed) break;  // every edge at its smallest rate: the mesh itself is the budget
-    triangles = countTriangles(surface, edgeRate);
+    triangles = countTriangles(surface, edgeRate, cancel);
   }
   if (options.ratesScaled) *options.ratesScaled = scaled;
 }
@@ -253,16 +266,8 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
 
   // 4. Tessellate and evaluate every face.
   std::vector<FacePatch> patches(faceCount);
-  parallelFor(faceCount, 16, [&](size_t begin, size_t end) {
-    cancel.check();
-    std::vector<int> rates;
-    for (size_t f = begin; f < end; ++f) {
-      if (!surface.hasLimit(static_cast<int>(f))) continue;
-      Far::ConstIndexArray edges = base.GetFaceEdges(static_cast<int>(f));
-      rates.resize(edges.size());
-      for (int k = 0; k < edges.size(); ++k) rates[k] = edgeRate[edges[k]];
-      patches[f] = tessellateFace(surface, static_cast<int>(f), rates.data());
-    }
+  forEachFaceWithRates(surface, edgeRate, 16, cancel, [&](int face, const int* rates) {
+    patches[face] = tessellateFace(surface, face, rates);
   });
   size_t triangles = 0;
   for (const FacePatch& p : patches) triangles += p.facets.size() / 3;

@@ -1,0 +1,40 @@
+// What the benchmark programs share: comma-separated flag values and corpus shapes read through
+// the real OBJ reader (scheme from the file name's prefix, as the corpus names them).
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "api/obj_reader.h"
+#include "render/mesh/control_mesh.h"
+
+namespace limn::bench {
+
+inline std::vector<std::string> splitList(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
+  return out;
+}
+
+inline render::mesh::Scheme schemeOfShape(const std::string& name) {
+  if (name.rfind("loop_", 0) == 0) return render::mesh::Scheme::Loop;
+  if (name.rfind("bilinear_", 0) == 0) return render::mesh::Scheme::Bilinear;
+  return render::mesh::Scheme::CatmullClark;
+}
+
+// The corpus shape `name` (without .obj) in `dir`, or nothing when the file is not there.
+inline std::optional<render::mesh::ControlMesh> readShape(const std::filesystem::path& dir,
+                                                          const std::string& name) {
+  std::ifstream file(dir / (name + ".obj"));
+  if (!file) return std::nullopt;
+  std::stringstream text;
+  text << file.rdbuf();
+  return api::readObj(text.str(), schemeOfShape(name), {}).mesh;
+}
+
+}  // namespace limn::bench
