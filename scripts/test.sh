@@ -6,4 +6,9 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build.sh
 cd build
+# --quick: everything but the programs labelled slow (the corpus at 1024^2), for development.
+if [ "${1:-}" = "--quick" ]; then
+  shift
+  set -- -LE slow "$@"
+fi
 ctest --output-on-failure -j "${LIMN_TEST_JOBS:-1}" "$@"
