@@ -28,7 +28,7 @@ ContourResult runContours(const ContourJob& job, const JobLimits& limits,
   mesh::validateMesh(job.mesh, limits.mesh);
   cancel.check();
 
-  const subdiv::LimitSurface surface(job.mesh);
+  const subdiv::LimitSurface surface(job.mesh, cancel);
   ContourResult result{.camera = resolveCamera(job.camera, surface.bounds()), .polylines = {},
                        .stats = {}, .timings = {}, .warnings = {}};
   const Camera& camera = result.camera;

@@ -198,7 +198,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   mesh::validateMesh(job.mesh, limits.mesh);
   cancel.check();
 
-  const subdiv::LimitSurface surface(job.mesh);
+  const subdiv::LimitSurface surface(job.mesh, cancel);
   Camera camera = resolveCamera(job.camera, surface.bounds());
   RenderResult result{.images = {}, .referenceImages = {}, .metrics = {}, .stats = {},
                       .timings = {}, .warnings = {}, .camera = camera};

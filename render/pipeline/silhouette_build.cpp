@@ -23,7 +23,7 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
   if (refine) {
     try {
       out.presubdivided =
-          std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh));
+          std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh), cancel);
     } catch (const InputError& e) {
       // A safety net: if OpenSubdiv refuses the refined topology (interior valence-2 vertices
       // that refining non-manifold meshes makes no longer are refused), draw the mesh unrefined

@@ -26,6 +26,10 @@ struct LimitSurface::FaceSurface {
 
 namespace {
 
+// How often construction looks at the request's cancel token: a face costs microseconds, or
+// about a millisecond around a vertex at the valence limit.
+constexpr int kFacesBetweenChecks = 16;
+
 // Far reports topology errors through one process-wide callback. The last message seen on this
 // thread is kept so the 422 can say what OpenSubdiv objected to.
 thread_local std::string farLastError;
@@ -114,12 +118,22 @@ std::unique_ptr<Far::TopologyRefiner> createTopologyRefiner(const mesh::ControlM
 
 LimitSurface::LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoOnFarPatches)
     : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(createTopologyRefiner(mesh_)) {
+  build(alsoOnFarPatches, CancelToken());
+}
+
+LimitSurface::LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel)
+    : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(createTopologyRefiner(mesh_)) {
+  build({}, cancel);
+}
+
+void LimitSurface::build(const std::vector<int>& alsoOnFarPatches, const CancelToken& cancel) {
   std::vector<int> farPatchFaces = facesBfrCannotEvaluate();
   farPatchFaces.insert(farPatchFaces.end(), alsoOnFarPatches.begin(), alsoOnFarPatches.end());
   std::sort(farPatchFaces.begin(), farPatchFaces.end());
   farPatchFaces.erase(std::unique(farPatchFaces.begin(), farPatchFaces.end()), farPatchFaces.end());
-  buildFaceSurfaces(farPatchFaces);
-  computeControlLimits();
+  cancel.check();
+  buildFaceSurfaces(farPatchFaces, cancel);
+  computeControlLimits(cancel);
 }
 
 LimitSurface::~LimitSurface() = default;
@@ -147,7 +161,8 @@ std::vector<int> LimitSurface::facesBfrCannotEvaluate() const {
   return faces;
 }
 
-void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces) {
+void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
+                                     const CancelToken& cancel) {
   if (!farPatchFaces.empty()) {
     // Far refines its refiner adaptively; refiner_ is shared (baseLevel()), so it gets its own.
     farPatches_ = std::make_unique<FarPatchSurface>(createRefiner(), farPatchFaces, mesh_.points);
@@ -167,6 +182,7 @@ void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces) {
   faces_.assign(mesh_.faceCount(), FaceData{});
   surfaces_.reserve(mesh_.faceCount());
   for (int f = 0; f < mesh_.faceCount(); ++f) {
+    if (f % kFacesBetweenChecks == 0) cancel.check();
     if (!factory.FaceHasLimitSurface(f)) continue;
     if (std::binary_search(farPatchFaces.begin(), farPatchFaces.end(), f)) {
       faces_[f].valid = farPatches_->covers(f, parameterization(f));
@@ -247,12 +263,13 @@ Vec3 LimitSurface::position(int face, double u, double v) const {
   return {p[0], p[1], p[2]};
 }
 
-void LimitSurface::computeControlLimits() {
+void LimitSurface::computeControlLimits(const CancelToken& cancel) {
   controlLimitPositions_ = mesh_.points;
   controlLimitNormals_.assign(mesh_.points.size(), Vec3{0, 0, 0});
   std::vector<bool> done(mesh_.points.size(), false);
   size_t offset = 0;
   for (int f = 0; f < mesh_.faceCount(); ++f) {
+    if (f % kFacesBetweenChecks == 0) cancel.check();
     int n = mesh_.faceVertexCounts[f];
     if (faces_[f].valid) {
       for (int k = 0; k < n; ++k) {

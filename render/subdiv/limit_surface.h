@@ -21,6 +21,7 @@
 #include <opensubdiv/bfr/parameterization.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
+#include "render/core/cancel.h"
 #include "render/core/vec.h"
 #include "render/mesh/control_mesh.h"
 
@@ -50,6 +51,10 @@ class LimitSurface {
   // `alsoOnFarPatches` (for tests): faces to evaluate through Far's patch table although Bfr
   // could, to compare the two.
   explicit LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoOnFarPatches = {});
+  // The same for a request: `cancel` is checked while the per-face surfaces are built (every
+  // few faces; a face around a vertex of valence n costs about n^2), and Cancelled thrown when
+  // it expires.
+  LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel);
   ~LimitSurface();
   LimitSurface(const LimitSurface&) = delete;
   LimitSurface& operator=(const LimitSurface&) = delete;
@@ -87,8 +92,9 @@ class LimitSurface {
  private:
   struct FaceSurface;
   std::vector<int> facesBfrCannotEvaluate() const;
-  void buildFaceSurfaces(const std::vector<int>& farPatchFaces);
-  void computeControlLimits();
+  void build(const std::vector<int>& alsoOnFarPatches, const CancelToken& cancel);
+  void buildFaceSurfaces(const std::vector<int>& farPatchFaces, const CancelToken& cancel);
+  void computeControlLimits(const CancelToken& cancel);
   void evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du,
                            Vec3& dv) const;
 

@@ -420,6 +420,43 @@ TEST(ServerLimits, FullQueueAnswers429WithRetryAfter) {
   EXPECT_EQ(server.terminate(SIGTERM), 0);
 }
 
+// A mesh whose limit surface alone takes tens of seconds to build (40 vertices at valence 500,
+// just under limits.maxValence): the 504 comes at the deadline, the worker stops building
+// within about a second of it and serves the next request.
+TEST(ServerLimits, DeadlineStopsTheLimitSurfaceBuild) {
+  auto server = ServerProcess::withConfig(R"({"workers": 1, "requestTimeoutMs": 500})");
+  std::string obj;
+  const int fans = 40, n = 500;
+  for (int fan = 0; fan < fans; ++fan) {
+    const int centre = fan * (n + 1) + 1;  // 1-based OBJ indices
+    obj += "v " + std::to_string(3 * fan) + " 0 0\\n";
+    for (int k = 0; k < n; ++k) {
+      double a = 2 * 3.14159265358979 * k / n;
+      obj += "v " + std::to_string(3 * fan + std::cos(a)) + " " + std::to_string(std::sin(a)) +
+             " 0\\n";
+    }
+    for (int k = 0; k < n; ++k) {
+      obj += "f " + std::to_string(centre) + " " + std::to_string(centre + 1 + k) + " " +
+             std::to_string(centre + 1 + (k + 1) % n) + "\\n";
+    }
+  }
+  std::string body = R"({"mesh": {"format": "obj", "scheme": "loop", "data": ")" + obj +
+                     R"("}, "method": "coarse", "outputs": ["color"]})";
+  auto start = std::chrono::steady_clock::now();
+  HttpResponse r = post(server.port(), "/v1/render", body);
+  EXPECT_EQ(r.status, 504) << r.body.substr(0, 300);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
+  int busy = -1;
+  for (int i = 0; i < 60 && busy != 0; ++i) {
+    busy = parseJson(get(server.port(), "/healthz").body)["busyWorkers"].GetInt();
+    if (busy != 0) std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(busy, 0) << "the worker is still building the limit surface";
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
+  EXPECT_EQ(post(server.port(), "/v1/render", smallRender()).status, 200);
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+}
+
 TEST(ServerLimits, RequestTimeoutGets504AndFreesTheWorker) {
   auto server = ServerProcess::withConfig(R"({"workers": 1, "requestTimeoutMs": 1})");
   auto start = std::chrono::steady_clock::now();

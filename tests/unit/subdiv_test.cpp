@@ -31,6 +31,13 @@ double bsplineBasis(int k, double t) {
   }
 }
 
+TEST(LimitSurface, ExpiredTokenStopsTheBuild) {
+  CancelToken cancel;
+  cancel.cancel();
+  EXPECT_THROW(LimitSurface(testing::torus(40, 25, false), cancel), Cancelled);
+  EXPECT_NO_THROW(LimitSurface(testing::torus(40, 25, false), CancelToken()));
+}
+
 TEST(LimitSurface, RegularCatmullClarkFaceIsTheBicubicBSpline) {
   const int n = 5;
   mesh::ControlMesh m = testing::grid(n, 0.3);
