@@ -1,5 +1,7 @@
 #include "server/worker_pool.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -114,6 +116,12 @@ void WorkerPool::submit(Work work, Reply reply) {
   reply(std::move(refusal));
 }
 
+// A large job (a reference at 1024^2 allocates about a gigabyte in passes, masks and
+// tessellations, across the TBB threads' malloc arenas) leaves that memory freed but resident:
+// glibc keeps it for reuse. Handing it back costs a few milliseconds, which is nothing after a
+// job that long and too much after every small one.
+void WorkerPool::returnFreedMemory() { malloc_trim(0); }
+
 WorkerPool::Reply WorkerPool::claimLocked(Job& job) {
   if (job.settled) return {};
   job.settled = true;
@@ -161,6 +169,7 @@ void WorkerPool::workerLoop(render::raster::Rasterizer& rasterizer) {
     }
     job->work = nullptr;  // frees the request body now rather than when the last owner lets go
     if (reply) reply(std::move(answer));
+    if (seconds > kTrimAfterSeconds) returnFreedMemory();
   }
 }
 

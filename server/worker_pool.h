@@ -97,6 +97,9 @@ class WorkerPool {
   // already (the watchdog and a worker can race for the same job).
   Reply claimLocked(Job& job);
   int retryAfterSecondsLocked() const;
+  // Jobs that ran longer than this return the memory they freed to the system afterwards.
+  static constexpr double kTrimAfterSeconds = 0.2;
+  static void returnFreedMemory();
 
   PoolOptions options_;
   std::vector<WorkerStatus> status_;  // written before the constructor returns, then read-only
