@@ -1,0 +1,147 @@
+// compareOutlines: see outline.h. Every located point of one outline is measured to the
+// nearest segment of the other through a bucket grid of segments.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "render/metrics/outline.h"
+
+namespace limn::render::metrics {
+
+namespace {
+double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
+  double dx = b.x - a.x, dy = b.y - a.y;
+  double len2 = dx * dx + dy * dy;
+  double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+// The segments of an outline (lone points as zero-length ones) bucketed in a uniform grid, for
+// nearest-segment queries that look at a few cells around the query point.
+class SegmentIndex {
+ public:
+  SegmentIndex(const Outline& outline, double x0, double y0, double x1, double y1)
+      : outline_(outline) {
+    std::vector<char> joined(outline.points.size(), 0);
+    for (auto [a, b] : outline.segments) {
+      items_.push_back({a, b});
+      joined[a] = joined[b] = 1;
+    }
+    for (size_t k = 0; k < joined.size(); ++k) {
+      if (!joined[k]) items_.push_back({static_cast<int>(k), static_cast<int>(k)});
+    }
+    // About four cells per item, at least half a pixel each.
+    double area = std::max(1.0, (x1 - x0) * (y1 - y0));
+    cell_ = std::max(0.5, std::sqrt(area / (4.0 * std::max<size_t>(1, items_.size()))));
+    x0_ = x0;
+    y0_ = y0;
+    nx_ = std::max(1, static_cast<int>(std::ceil((x1 - x0) / cell_)));
+    ny_ = std::max(1, static_cast<int>(std::ceil((y1 - y0) / cell_)));
+    std::vector<int> counts(static_cast<size_t>(nx_) * ny_ + 1, 0);
+    forEachCell([&](size_t cell, int) { ++counts[cell + 1]; });
+    for (size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+    start_ = counts;
+    entries_.resize(counts.back());
+    forEachCell([&](size_t cell, int item) { entries_[counts[cell]++] = item; });
+  }
+
+  // Distance from p (inside the index's bounds) to the nearest item.
+  double nearest(Vec2 p) const {
+    constexpr int kMaxRing = 16;  // beyond it, every item is looked at
+    int cx = cellX(p.x), cy = cellY(p.y);
+    double best = std::numeric_limits<double>::infinity();
+    for (int ring = 0; ring <= kMaxRing; ++ring) {
+      for (int y = cy - ring; y <= cy + ring; ++y) {
+        if (y < 0 || y >= ny_) continue;
+        bool edgeRow = y == cy - ring || y == cy + ring;
+        for (int x = cx - ring; x <= cx + ring; x += edgeRow ? 1 : 2 * std::max(ring, 1)) {
+          if (x < 0 || x >= nx_) continue;
+          size_t cell = static_cast<size_t>(y) * nx_ + x;
+          for (int k = start_[cell]; k < start_[cell + 1]; ++k) best = std::min(best, distance(p, entries_[k]));
+        }
+      }
+      // Items in rings further out are at least `ring` cells away.
+      if (best <= ring * cell_) return best;
+    }
+    for (size_t k = 0; k < items_.size(); ++k) best = std::min(best, distance(p, static_cast<int>(k)));
+    return best;
+  }
+
+ private:
+  int cellX(double x) const { return std::clamp(static_cast<int>((x - x0_) / cell_), 0, nx_ - 1); }
+  int cellY(double y) const { return std::clamp(static_cast<int>((y - y0_) / cell_), 0, ny_ - 1); }
+  double distance(Vec2 p, int item) const {
+    return pointSegmentDistance(p, outline_.points[items_[item].first],
+                                outline_.points[items_[item].second]);
+  }
+  template <typename Fn>
+  void forEachCell(Fn fn) const {
+    for (size_t k = 0; k < items_.size(); ++k) {
+      Vec2 a = outline_.points[items_[k].first], b = outline_.points[items_[k].second];
+      for (int y = cellY(std::min(a.y, b.y)); y <= cellY(std::max(a.y, b.y)); ++y) {
+        for (int x = cellX(std::min(a.x, b.x)); x <= cellX(std::max(a.x, b.x)); ++x) {
+          fn(static_cast<size_t>(y) * nx_ + x, static_cast<int>(k));
+        }
+      }
+    }
+  }
+
+  const Outline& outline_;
+  std::vector<std::pair<int, int>> items_;
+  double cell_ = 1, x0_ = 0, y0_ = 0;
+  int nx_ = 1, ny_ = 1;
+  std::vector<int> start_, entries_;
+};
+
+bool insideFrame(const Outline& o, Vec2 p) {
+  return p.x >= 0.5 && p.y >= 0.5 && p.x <= o.frameWidth - 0.5 && p.y <= o.frameHeight - 0.5;
+}
+
+// Distances from every point of `from` inside its frame to the nearest item of `index`.
+std::vector<double> directedDistances(const Outline& from, const SegmentIndex& index) {
+  std::vector<Vec2> measured;
+  for (Vec2 p : from.points) {
+    if (insideFrame(from, p)) measured.push_back(p);
+  }
+  std::vector<double> d(measured.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, d.size(), 256),
+                    [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) d[k] = index.nearest(measured[k]);
+  });
+  return d;
+}
+
+}  // namespace
+
+OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx) {
+  if (a.empty() && b.empty()) return {};
+  if (a.empty() || b.empty()) return {farPx, farPx};
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  for (const Outline* o : {&a, &b}) {
+    for (Vec2 p : o->points) {
+      x0 = std::min(x0, p.x);
+      y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x);
+      y1 = std::max(y1, p.y);
+    }
+  }
+  SegmentIndex indexA(a, x0, y0, x1, y1), indexB(b, x0, y0, x1, y1);
+  std::vector<double> ab = directedDistances(a, indexB), ba = directedDistances(b, indexA);
+  OutlineDistances result;
+  double sum = 0;
+  for (const std::vector<double>* d : {&ab, &ba}) {
+    for (double v : *d) {
+      result.hausdorffPx = std::max(result.hausdorffPx, v);
+      sum += v;
+    }
+  }
+  if (!ab.empty() || !ba.empty()) result.meanPx = sum / static_cast<double>(ab.size() + ba.size());
+  return result;
+}
+
+}  // namespace limn::render::metrics
