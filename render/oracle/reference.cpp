@@ -161,6 +161,79 @@ metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,
   };
 }
 
+// Moves every primary hit onto the limit surface (Newton) and writes the passes; counts hits
+// and failures into result.stats, and warns about the wireframe and about many failures.
+void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
+               const tessellate::TriangleMesh& mesh, const std::vector<PixelHit>& hits,
+               const PassSelection& passes, const CancelToken& cancel, ReferenceResult& result) {
+  const int width = camera.width(), height = camera.height();
+  PassImages images(result.images, passes, width, height);
+  const double tolerance = kRelativeTolerance * std::max(surface.bounds().diagonal(), 1e-300);
+  std::atomic<size_t> covered{0}, failures{0};
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
+    if (cancelled || cancel.expired()) {
+      cancelled = true;
+      return;
+    }
+    size_t rowCovered = 0, rowFailures = 0;
+    for (int y = r.begin(); y < r.end(); ++y) {
+      for (int x = 0; x < width; ++x) {
+        const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
+        if (!h.hit()) continue;
+        PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
+        int face;
+        Vec2 uv;
+        SurfaceHit hit = triangleHitUV(surface, mesh, h.primID, h.u, h.v, &face, &uv)
+                             ? refineHit(surface, face, uv, ray, h.t, tolerance)
+                             : unrefinedHit(surface, face, uv, ray, h.t);
+        ++rowCovered;
+        rowFailures += !hit.refined;
+        images.write(x, y, hit, camera);
+      }
+    }
+    covered += rowCovered;
+    failures += rowFailures;
+  });
+  if (cancelled) throw Cancelled();
+  ReferenceStats& stats = result.stats;
+  stats.hits = covered;
+  stats.newtonFailures = failures;
+  if (passes.wireframe) {
+    result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
+    if (!passes.color) result.images.passes.erase(pass::kColor);
+    result.warnings.push_back(
+        "reference wireframe: the limit surface has no edges; the pass is the shaded color");
+  }
+  if (stats.hits > 0 && stats.newtonFailures * 1000 > stats.hits) {
+    result.warnings.push_back("reference: " + std::to_string(stats.newtonFailures) + " of " +
+                              std::to_string(stats.hits) +
+                              " hits could not be refined onto the limit surface (kept on the "
+                              "dense tessellation)");
+  }
+}
+
+// The supersampled mask, S x S rays only in the pixels that need them (result.refinedPixels).
+void castSupersampledMask(const ReferenceTessellation& tessellation, RTCScene scene,
+                          const Camera& camera, const std::vector<PixelHit>& hits, int s,
+                          const Image* hint, const CancelToken& cancel, ReferenceResult& result) {
+  const int width = camera.width(), height = camera.height();
+  std::vector<char> coverage(hits.size());
+  for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
+  if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
+    hint = nullptr;
+  }
+  result.refinedPixels = pixelsToRefine(coverage, outlineCandidates(tessellation, camera), width,
+                                        height, hint, s);
+  size_t refined = 0;
+  for (char r : result.refinedPixels) refined += r != 0;
+  result.stats.refinedPixels = refined;
+  result.stats.raysCast += refined * s * s;
+  result.images.supersampledMask =
+      castCoverageRefined(scene, camera, s, result.refinedPixels, coverage, cancel);
+  result.images.supersample = s;
+}
+
 }  // namespace
 
 ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
@@ -200,83 +273,27 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
   cancel.check();
 
   // Primary rays at pixel centres: the passes, and the coverage the supersampled mask starts from.
-  const int width = camera.width(), height = camera.height();
   auto start = Clock::now();
   std::vector<PixelHit> hits = castClosestHits(scene, camera, RayPacking::Packet16, cancel);
   stats.traceMs = msSince(start);
   stats.raysCast += hits.size();
 
   start = Clock::now();
-  PassImages images(result.images, passes, width, height);
-  const double tolerance = kRelativeTolerance * std::max(surface.bounds().diagonal(), 1e-300);
-  std::atomic<size_t> covered{0}, failures{0};
-  std::atomic<bool> cancelled{false};
-  tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
-    if (cancelled || cancel.expired()) {
-      cancelled = true;
-      return;
-    }
-    size_t rowCovered = 0, rowFailures = 0;
-    for (int y = r.begin(); y < r.end(); ++y) {
-      for (int x = 0; x < width; ++x) {
-        const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
-        if (!h.hit()) continue;
-        PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
-        int face;
-        Vec2 uv;
-        SurfaceHit hit = triangleHitUV(surface, mesh, h.primID, h.u, h.v, &face, &uv)
-                             ? refineHit(surface, face, uv, ray, h.t, tolerance)
-                             : unrefinedHit(surface, face, uv, ray, h.t);
-        ++rowCovered;
-        rowFailures += !hit.refined;
-        images.write(x, y, hit, camera);
-      }
-    }
-    covered += rowCovered;
-    failures += rowFailures;
-  });
-  if (cancelled) throw Cancelled();
-  stats.hits = covered;
-  stats.newtonFailures = failures;
+  shadeHits(surface, camera, mesh, hits, passes, cancel, result);
   stats.newtonMs = msSince(start);
-  if (passes.wireframe) {
-    result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
-    if (!passes.color) result.images.passes.erase(pass::kColor);
-    result.warnings.push_back(
-        "reference wireframe: the limit surface has no edges; the pass is the shaded color");
-  }
-  if (stats.hits > 0 && stats.newtonFailures * 1000 > stats.hits) {
-    result.warnings.push_back("reference: " + std::to_string(stats.newtonFailures) + " of " +
-                              std::to_string(stats.hits) +
-                              " hits could not be refined onto the limit surface (kept on the "
-                              "dense tessellation)");
-  }
 
   if (passes.supersample > 0) {
-    const int s = passes.supersample;
     start = Clock::now();
-    std::vector<char> coverage(hits.size());
-    for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
-    const Image* hint = options.maskHint;
-    if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
-      hint = nullptr;
-    }
-    std::vector<char> refine = pixelsToRefine(coverage, outlineCandidates(tessellation, camera),
-                                              width, height, hint, s);
-    for (char r : refine) stats.refinedPixels += r != 0;
-    result.images.supersampledMask = castCoverageRefined(scene, camera, s, refine, coverage, cancel);
-    result.images.supersample = s;
-    stats.raysCast += stats.refinedPixels * s * s;
+    castSupersampledMask(tessellation, scene, camera, hits, passes.supersample, options.maskHint,
+                         cancel, result);
     stats.maskMs = msSince(start);
-
     if (options.locateOutline) {
       start = Clock::now();
-      result.outline = metrics::locateOutline(result.images.supersampledMask, s,
+      result.outline = metrics::locateOutline(result.images.supersampledMask, passes.supersample,
                                               coverageQuery(scene, camera, cancel), cancel,
-                                              &refine);
+                                              &result.refinedPixels);
       stats.outlineMs = msSince(start);
     }
-    result.refinedPixels = std::move(refine);
   }
   return result;
 }
