@@ -64,6 +64,19 @@ class ConfigReader {
     }
   }
 
+  void strings(const char* key, std::vector<std::string>& target) {
+    if (const Value* v = take(key)) {
+      if (!v->IsArray()) fail(path(key), "must be an array of strings");
+      target.clear();
+      for (const Value& item : v->GetArray()) {
+        if (!item.IsString() || item.GetStringLength() == 0) {
+          fail(path(key), "must be an array of non-empty strings");
+        }
+        target.emplace_back(item.GetString(), item.GetStringLength());
+      }
+    }
+  }
+
   const Value* object(const char* key) { return take(key); }
 
   // Every key must have been taken by now.
@@ -130,6 +143,8 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.size("maxBodyBytes", config.maxBodyBytes, 1);
   r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);
   r.size("referenceCacheBytes", config.referenceCacheBytes, 0);
+  r.string("authToken", config.authToken);
+  r.strings("corsOrigins", config.corsOrigins);
   if (const Value* limits = r.object("limits")) readLimits(*limits, source, config.limits);
   r.finish();
   return config;

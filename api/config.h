@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "render/pipeline/render_job.h"
 
@@ -23,6 +24,11 @@ struct ServiceConfig {
   int requestTimeoutMs = 120000;
   // Reference tessellations + BVHs kept for further requests with the same mesh and camera.
   size_t referenceCacheBytes = 512u << 20;
+  // Bearer token the /v1 routes require ("" = none); the environment variable LIMN_AUTH_TOKEN
+  // sets it when the file does not (limn serve), so it need not be written to a file.
+  std::string authToken;
+  // Web origins whose pages may read limn's answers (CORS); "*" = any; empty = none.
+  std::vector<std::string> corsOrigins;
   render::pipeline::JobLimits limits;
 };
 

@@ -131,7 +131,9 @@ void Connection::handle() {
   auto message = parser_->release();
   bool keepAlive = message.keep_alive();
   Request request{std::string(message.method_string()), std::string(message.target()),
-                  std::move(message.body()), std::string(message[http::field::accept])};
+                  std::move(message.body()), std::string(message[http::field::accept]),
+                  std::string(message[http::field::authorization]),
+                  std::string(message[http::field::origin])};
   // The router may answer from a worker thread: hop back onto this connection's strand.
   shared_.router.handle(std::move(request),
                         [self = shared_from_this(), keepAlive](api::Answer answer) {

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -170,7 +171,11 @@ int serve(const CommandLine& cl) {
               << " (EGL " << device.eglPlatform << ")\n";
   }
 
-  server::Router router(config->limits, pool);
+  server::AccessOptions access{config->authToken, config->corsOrigins};
+  if (access.authToken.empty()) {
+    if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token) access.authToken = token;
+  }
+  server::Router router(config->limits, pool, access);
   server::HttpOptions httpOptions;
   httpOptions.host = config->host;
   httpOptions.port = config->port;

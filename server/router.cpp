@@ -96,11 +96,31 @@ std::string Router::routeLabel(std::string_view target) {
   return "other";
 }
 
-Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool)
-    : limits_(limits), pool_(pool), started_(std::chrono::steady_clock::now()) {}
+Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, AccessOptions access)
+    : limits_(limits),
+      pool_(pool),
+      access_(std::move(access)),
+      started_(std::chrono::steady_clock::now()) {}
 
 void Router::handle(Request request, Reply reply) {
+  if (access_.originAllowed(request.origin)) {
+    // Every answer to this origin, now or from a worker later, carries the CORS headers.
+    reply = [origin = request.origin, reply = std::move(reply)](api::Answer answer) {
+      addCorsHeaders(origin, answer);
+      reply(std::move(answer));
+    };
+  }
   std::string_view path = pathOf(request.target);
+  if (request.method == "OPTIONS" && routeLabel(path) != "other") {
+    if (auto preflight = access_.preflight(request.origin)) return reply(std::move(*preflight));
+  }
+  if (auto refusal = access_.refuse(path, request.authorization)) return reply(std::move(*refusal));
+  route(std::move(request), std::move(reply));
+}
+
+void Router::route(Request request, Reply reply) {
+  const std::string target = request.target;
+  std::string_view path = pathOf(target);
   std::vector<std::string> allowed;
   for (const Route& route : kRoutes) {
     if (path == route.path) allowed.emplace_back(route.method);

@@ -2,7 +2,8 @@
 //
 // The HTTP layer hands it (method, target, body) and a reply callback; the router answers the
 // service endpoints at once (/healthz, /readyz, /metrics, /openapi.json), sends renders to the
-// WorkerPool, and answers 404/405 JSON for everything else. Tests call it directly.
+// WorkerPool, and answers 404/405 JSON for everything else; access.h's rules (bearer token,
+// CORS) come first. Tests call it directly.
 //
 //   GET  /healthz       liveness and what the workers run on
 //   GET  /readyz        200 when a render would be accepted now, else 503
@@ -19,6 +20,7 @@
 
 #include "api/render_api.h"
 #include "render/pipeline/render_job.h"
+#include "server/access.h"
 #include "server/request_stats.h"
 #include "server/worker_pool.h"
 
@@ -29,13 +31,16 @@ struct Request {
   std::string target;  // path, possibly with "?query"
   std::string body;
   std::string accept = {};  // the Accept header ("" when absent): /v1/silhouette may answer SVG
+  std::string authorization = {};  // the Authorization header ("" when absent)
+  std::string origin = {};         // the Origin header ("" when absent)
 };
 
 class Router {
  public:
   using Reply = std::function<void(api::Answer)>;
 
-  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool);
+  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool,
+         AccessOptions access = {});
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
   // the pool's watchdog for renders.
@@ -54,8 +59,11 @@ class Router {
   void render(std::string body, Reply reply);
   void silhouette(std::string body, std::string accept, Reply reply);
 
+  void route(Request request, Reply reply);
+
   render::pipeline::JobLimits limits_;
   WorkerPool& pool_;
+  Access access_;
   RequestStats stats_;
   std::chrono::steady_clock::time_point started_;
 };

@@ -457,6 +457,54 @@ TEST(ServerLimits, DeadlineStopsTheLimitSurfaceBuild) {
   EXPECT_EQ(server.terminate(SIGTERM), 0);
 }
 
+// A configured bearer token guards the /v1 routes and nothing else; configured origins get CORS
+// headers on every answer and a 204 to their preflights, which carry no token.
+TEST(ServerAccess, BearerTokenAndCors) {
+  auto server = ServerProcess::withConfig(
+      R"({"workers": 1, "authToken": "s3cret-token", "corsOrigins": ["http://localhost:5173"]})");
+  const int port = server.port();
+  HttpResponse none = post(port, "/v1/render", smallRender());
+  EXPECT_EQ(none.status, 401);
+  EXPECT_EQ(errorCode(none), "unauthorized");
+  EXPECT_EQ(none.header("WWW-Authenticate"), "Bearer");
+  HttpResponse wrong =
+      post(port, "/v1/render", smallRender(), {{"Authorization", "Bearer s3cret-tokeX"}});
+  EXPECT_EQ(wrong.status, 401);
+  EXPECT_EQ(post(port, "/v1/silhouette", smallRender()).status, 401);
+  HttpResponse right =
+      post(port, "/v1/render", smallRender(), {{"Authorization", "Bearer s3cret-token"}});
+  EXPECT_EQ(right.status, 200) << right.body.substr(0, 200);
+  for (const char* open : {"/healthz", "/readyz", "/metrics", "/openapi.json"}) {
+    EXPECT_EQ(get(port, open).status, 200) << open;
+  }
+
+  HttpClient client(port);
+  HttpResponse preflight = client.request(
+      "OPTIONS", "/v1/render", "",
+      {{"Origin", "http://localhost:5173"}, {"Access-Control-Request-Method", "POST"},
+       {"Access-Control-Request-Headers", "authorization, content-type"}});
+  EXPECT_EQ(preflight.status, 204);
+  EXPECT_EQ(preflight.header("Access-Control-Allow-Origin"), "http://localhost:5173");
+  EXPECT_NE(preflight.header("Access-Control-Allow-Headers").find("Authorization"),
+            std::string::npos);
+  EXPECT_NE(preflight.header("Access-Control-Allow-Methods").find("POST"), std::string::npos);
+  HttpResponse cors = client.request(
+      "POST", "/v1/render", smallRender(),
+      {{"Origin", "http://localhost:5173"}, {"Authorization", "Bearer s3cret-token"}});
+  EXPECT_EQ(cors.status, 200);
+  EXPECT_EQ(cors.header("Access-Control-Allow-Origin"), "http://localhost:5173");
+  // Refusals carry the header too, so the page can read why.
+  HttpResponse refusedCors =
+      client.request("POST", "/v1/render", smallRender(), {{"Origin", "http://localhost:5173"}});
+  EXPECT_EQ(refusedCors.status, 401);
+  EXPECT_EQ(refusedCors.header("Access-Control-Allow-Origin"), "http://localhost:5173");
+  HttpResponse stranger =
+      client.request("OPTIONS", "/v1/render", "", {{"Origin", "http://elsewhere.example"}});
+  EXPECT_NE(stranger.status, 204);
+  EXPECT_FALSE(stranger.has("Access-Control-Allow-Origin"));
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+}
+
 TEST(ServerLimits, RequestTimeoutGets504AndFreesTheWorker) {
   auto server = ServerProcess::withConfig(R"({"workers": 1, "requestTimeoutMs": 1})");
   auto start = std::chrono::steady_clock::now();

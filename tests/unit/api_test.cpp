@@ -1078,6 +1078,21 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_EQ(file.limits.maxLevel, builtIn.limits.maxLevel);
   EXPECT_EQ(file.limits.minDicingRate, builtIn.limits.minDicingRate);
   EXPECT_EQ(file.limits.maxTriangles, builtIn.limits.maxTriangles);
+  EXPECT_EQ(file.limits.mesh.maxValence, builtIn.limits.mesh.maxValence);
+  EXPECT_EQ(file.referenceCacheBytes, builtIn.referenceCacheBytes);
+  EXPECT_TRUE(file.authToken.empty());
+  EXPECT_TRUE(file.corsOrigins.empty());
+}
+
+TEST(Config, AuthTokenAndCorsOrigins) {
+  api::ServiceConfig c = api::parseConfig(
+      R"({"authToken": "t0ken", "corsOrigins": ["http://localhost:5173", "*"]})");
+  EXPECT_EQ(c.authToken, "t0ken");
+  ASSERT_EQ(c.corsOrigins.size(), 2u);
+  EXPECT_EQ(c.corsOrigins[1], "*");
+  EXPECT_THROW(api::parseConfig(R"({"authToken": ""})"), api::ConfigError);
+  EXPECT_THROW(api::parseConfig(R"({"corsOrigins": "*"})"), api::ConfigError);
+  EXPECT_THROW(api::parseConfig(R"({"corsOrigins": [1]})"), api::ConfigError);
 }
 
 TEST(Config, ReadsValuesAndKeepsDefaultsForMissingKeys) {
