@@ -18,6 +18,9 @@ struct Answer {
   std::string contentType = "application/json";
   std::string body;
   std::vector<std::pair<std::string, std::string>> headers;  // extra, e.g. Retry-After
+  // For the server's request log, not the client: the engine's stage times as a JSON object
+  // (renders), or "".
+  std::string logStages;
 };
 
 // A request the api layer refuses. `code` is one of DESIGN.md's error codes

@@ -145,6 +145,11 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.size("referenceCacheBytes", config.referenceCacheBytes, 0);
   r.string("authToken", config.authToken);
   r.strings("corsOrigins", config.corsOrigins);
+  r.string("logLevel", config.logLevel);
+  if (config.logLevel != "debug" && config.logLevel != "info" && config.logLevel != "warn" &&
+      config.logLevel != "error" && config.logLevel != "off") {
+    throw ConfigError(source + ": \"logLevel\" must be debug, info, warn, error or off");
+  }
   if (const Value* limits = r.object("limits")) readLimits(*limits, source, config.limits);
   r.finish();
   return config;

@@ -29,6 +29,8 @@ struct ServiceConfig {
   std::string authToken;
   // Web origins whose pages may read limn's answers (CORS); "*" = any; empty = none.
   std::vector<std::string> corsOrigins;
+  // The request log's level on stderr: "debug", "info", "warn", "error" or "off".
+  std::string logLevel = "info";
   render::pipeline::JobLimits limits;
 };
 

@@ -24,6 +24,8 @@ set_target_properties(OpenImageIO::OpenImageIO PROPERTIES
 
 # RapidJSON ships only include directories.
 find_package(RapidJSON REQUIRED)
+# spdlog (Debian's, built against the system fmt): the server's request log.
+find_package(spdlog REQUIRED)
 add_library(rapidjson INTERFACE)
 target_include_directories(rapidjson INTERFACE ${RAPIDJSON_INCLUDE_DIRS})
 

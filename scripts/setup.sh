@@ -7,7 +7,7 @@ packages=(
   cmake ninja-build g++ pkg-config
   libembree-dev libosd-dev libopenimageio-dev openimageio-tools libboost-dev rapidjson-dev
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev curl
+  libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev curl
 )
 
 missing=()

@@ -74,6 +74,8 @@ void Connection::readHeader() {
   phase_ = Phase::Reading;
   readTimedOut_ = false;
   route_ = "other";
+  method_ = "-";
+  bytesIn_ = 0;
   version_ = 11;
   parser_.emplace();
   parser_->body_limit(shared_.limits.maxBodyBytes);
@@ -90,6 +92,7 @@ void Connection::onHeader(error_code ec) {
     const auto& request = parser_->get();
     version_ = request.version();
     route_ = Router::routeLabel(std::string_view(request.target().data(), request.target().size()));
+    method_ = std::string(request.method_string());
   }
   if (ec) return refuse(ec);
   if (version_ != 10 && version_ != 11) {
@@ -130,6 +133,7 @@ void Connection::handle() {
   phase_ = Phase::Handling;
   auto message = parser_->release();
   bool keepAlive = message.keep_alive();
+  bytesIn_ = message.body().size();
   Request request{std::string(message.method_string()), std::string(message.target()),
                   std::move(message.body()), std::string(message[http::field::accept]),
                   std::string(message[http::field::authorization]),
@@ -154,12 +158,17 @@ void Connection::answer(api::Answer answer, bool close) {
   response.set(http::field::server, "limn/" LIMN_VERSION);
   response.set(http::field::content_type, answer.contentType);
   for (const auto& [name, value] : answer.headers) response.set(name, value);
+  const uint64_t id = shared_.router.log().nextId();
+  response.set("X-Request-Id", std::to_string(id));
   response.keep_alive(!close);
+  const size_t bytesOut = answer.body.size();
   response.body() = std::move(answer.body);
   response.prepare_payload();
 
   double seconds = std::chrono::duration<double>(Clock::now() - requestStart_).count();
   shared_.router.stats().record(route_, answer.status, seconds);
+  shared_.router.log().answered(
+      {id, method_, route_, answer.status, seconds, bytesIn_, bytesOut, answer.logStages});
 
   armTimer(shared_.limits.writeTimeout);
   http::async_write(socket_, response,

@@ -109,6 +109,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool closeAfterWrite_ = false;
   unsigned version_ = 11;
   std::string route_ = "other";
+  std::string method_ = "-";  // of the request being answered, for the request log
+  size_t bytesIn_ = 0;        // its body
   std::chrono::steady_clock::time_point requestStart_;
   char drainBuffer_[4096];
 };

@@ -175,7 +175,7 @@ int serve(const CommandLine& cl) {
   if (access.authToken.empty()) {
     if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token) access.authToken = token;
   }
-  server::Router router(config->limits, pool, access);
+  server::Router router(config->limits, pool, access, config->logLevel);
   server::HttpOptions httpOptions;
   httpOptions.host = config->host;
   httpOptions.port = config->port;

@@ -96,10 +96,12 @@ std::string Router::routeLabel(std::string_view target) {
   return "other";
 }
 
-Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, AccessOptions access)
+Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, AccessOptions access,
+               const std::string& logLevel)
     : limits_(limits),
       pool_(pool),
       access_(std::move(access)),
+      log_(logLevel),
       started_(std::chrono::steady_clock::now()) {}
 
 void Router::handle(Request request, Reply reply) {

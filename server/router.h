@@ -21,6 +21,7 @@
 #include "api/render_api.h"
 #include "render/pipeline/render_job.h"
 #include "server/access.h"
+#include "server/request_log.h"
 #include "server/request_stats.h"
 #include "server/worker_pool.h"
 
@@ -40,7 +41,7 @@ class Router {
   using Reply = std::function<void(api::Answer)>;
 
   Router(const render::pipeline::JobLimits& limits, WorkerPool& pool,
-         AccessOptions access = {});
+         AccessOptions access = {}, const std::string& logLevel = "info");
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
   // the pool's watchdog for renders.
@@ -51,6 +52,7 @@ class Router {
 
   // The HTTP layer records every answer it writes here.
   RequestStats& stats() { return stats_; }
+  RequestLog& log() { return log_; }
 
  private:
   api::Answer healthz() const;
@@ -65,6 +67,7 @@ class Router {
   WorkerPool& pool_;
   Access access_;
   RequestStats stats_;
+  RequestLog log_;
   std::chrono::steady_clock::time_point started_;
 };
 

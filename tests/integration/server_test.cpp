@@ -127,6 +127,9 @@ TEST_F(ServerTest, OpenApiDocumentDescribesRender) {
 TEST_F(ServerTest, RenderOfACubeAnswersAPng) {
   HttpResponse r = post(port(), "/v1/render", smallRender());
   ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+  // Every answer names its line in the request log; ids only grow.
+  uint64_t id = std::stoull(r.header("X-Request-Id"));
+  EXPECT_GT(std::stoull(get(port(), "/healthz").header("X-Request-Id")), id);
   auto doc = parseJson(r.body);
   ASSERT_FALSE(doc.HasParseError());
   const auto& color = doc["images"]["color"];

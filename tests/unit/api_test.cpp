@@ -1082,6 +1082,7 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_EQ(file.referenceCacheBytes, builtIn.referenceCacheBytes);
   EXPECT_TRUE(file.authToken.empty());
   EXPECT_TRUE(file.corsOrigins.empty());
+  EXPECT_EQ(file.logLevel, builtIn.logLevel);
 }
 
 TEST(Config, AuthTokenAndCorsOrigins) {
@@ -1093,6 +1094,8 @@ TEST(Config, AuthTokenAndCorsOrigins) {
   EXPECT_THROW(api::parseConfig(R"({"authToken": ""})"), api::ConfigError);
   EXPECT_THROW(api::parseConfig(R"({"corsOrigins": "*"})"), api::ConfigError);
   EXPECT_THROW(api::parseConfig(R"({"corsOrigins": [1]})"), api::ConfigError);
+  EXPECT_EQ(api::parseConfig(R"({"logLevel": "warn"})").logLevel, "warn");
+  EXPECT_THROW(api::parseConfig(R"({"logLevel": "loud"})"), api::ConfigError);
 }
 
 TEST(Config, ReadsValuesAndKeepsDefaultsForMissingKeys) {

@@ -2,17 +2,21 @@
 // rules, and the Router's answers. (tests/integration drives the real process over HTTP.)
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
+#include <spdlog/sinks/ostream_sink.h>
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <future>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "api/render_api.h"
 #include "server/http_server.h"
+#include "server/request_log.h"
 #include "server/router.h"
 #include "server/worker_pool.h"
 #include "tests/integration/http_client.h"
@@ -89,6 +93,43 @@ api::Answer ok(const char* body = "{}") {
   api::Answer a;
   a.body = body;
   return a;
+}
+
+// The request log writes one parseable JSON object per line, with the fields a log shipper
+// expects, errors at level error, and nothing below its level.
+TEST(RequestLog, OneJsonObjectPerAnsweredRequest) {
+  std::ostringstream text;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
+  RequestLog log("info", sink);
+  uint64_t first = log.nextId(), second = log.nextId();
+  EXPECT_EQ(second, first + 1);
+  log.answered({first, "POST", "/v1/render", 200, 0.0123, 512, 20060,
+                R"({"surfaceMs":0.4,"rasterMs":5.0})"});
+  log.answered({second, "GET", "other", 503, 0.001, 0, 90, ""});
+  std::istringstream lines(text.str());
+  std::vector<rapidjson::Document> docs;
+  for (std::string line; std::getline(lines, line);) {
+    docs.emplace_back();
+    docs.back().Parse(line.c_str());
+    ASSERT_FALSE(docs.back().HasParseError()) << line;
+  }
+  ASSERT_EQ(docs.size(), 2u);
+  EXPECT_EQ(docs[0]["id"].GetUint64(), first);
+  EXPECT_STREQ(docs[0]["level"].GetString(), "info");
+  EXPECT_STREQ(docs[0]["route"].GetString(), "/v1/render");
+  EXPECT_EQ(docs[0]["status"].GetInt(), 200);
+  EXPECT_NEAR(docs[0]["ms"].GetDouble(), 12.3, 1e-9);
+  EXPECT_EQ(docs[0]["out"].GetInt(), 20060);
+  EXPECT_DOUBLE_EQ(docs[0]["stages"]["rasterMs"].GetDouble(), 5.0);
+  EXPECT_EQ(std::string(docs[0]["ts"].GetString()).back(), 'Z');
+  EXPECT_STREQ(docs[1]["level"].GetString(), "error");
+  EXPECT_FALSE(docs[1].HasMember("stages"));
+
+  std::ostringstream quiet;
+  RequestLog errorsOnly("error", std::make_shared<spdlog::sinks::ostream_sink_mt>(quiet));
+  errorsOnly.answered({1, "GET", "/healthz", 200, 0.001, 0, 10, ""});
+  EXPECT_TRUE(quiet.str().empty());
+  EXPECT_THROW(RequestLog("loud"), std::invalid_argument);
 }
 
 TEST(WorkerPool, RunsJobsOnWorkersThatOwnARasterizer) {
