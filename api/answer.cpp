@@ -1,9 +1,9 @@
 #include "api/answer.h"
 
-#include <new>
-
 #include <rapidjson/stringbuffer.h>
 #include <rapidjson/writer.h>
+
+#include <new>
 
 #include "api/json_util.h"
 

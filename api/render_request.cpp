@@ -133,18 +133,19 @@ void parseSilhouetteParams(const Value& params, const JobLimits& limits,
   if (const Value* v = json::find(params, "contour")) {
     out.contour = json::choice<render::silhouette::CurveMode>(
         *v, "params.contour",
-        {{"exact", render::silhouette::CurveMode::Exact}, {"pn", render::silhouette::CurveMode::PN}});
+        {{"exact", render::silhouette::CurveMode::Exact},
+         {"pn", render::silhouette::CurveMode::PN}});
   }
 }
 
 render::pipeline::MethodParams parseParams(const Value& params, const JobLimits& limits,
                                            std::vector<std::string>& warnings) {
   json::requireObject(params, "params");
-  warnUnknownFields(params, "params",
-                    {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample",
-                     "referenceCrossCheck",
-                     "presubdivide", "searchSteps", "curveSamples", "contour"},
-                    warnings);
+  warnUnknownFields(
+      params, "params",
+      {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample", "referenceCrossCheck",
+       "presubdivide", "searchSteps", "curveSamples", "contour"},
+      warnings);
   render::pipeline::MethodParams out;
   if (const Value* v = json::find(params, "level")) {
     out.level = json::integer(*v, "params.level");
@@ -208,8 +209,8 @@ render::pipeline::Outputs parseOutputs(const Value& value) {
                                     {"wireframe", Wireframe},
                                     {"contours", Contours},
                                     {"cage", Cage}});
-    bool* flags[] = {&out.color, &out.mask, &out.depth, &out.normal, &out.wireframe,
-                     &out.contours, &out.cage};
+    bool* flags[] = {&out.color,     &out.mask,     &out.depth, &out.normal,
+                     &out.wireframe, &out.contours, &out.cage};
     *flags[pass] = true;
   }
   return out;
@@ -264,24 +265,25 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
   if (const Value* v = json::find(root, "method")) job.method = parseMethod(*v);
   if (const Value* v = json::find(root, "params")) job.params = parseParams(*v, limits, warnings);
   if (const Value* v = json::find(root, "shading")) {
-    job.shading = json::choice<render::Shading>(
-        *v, "shading",
-        {{"flat", render::Shading::Flat},
-         {"smooth", render::Shading::Smooth},
-         {"normal-map", render::Shading::NormalMap}});
+    job.shading = json::choice<render::Shading>(*v, "shading",
+                                                {{"flat", render::Shading::Flat},
+                                                 {"smooth", render::Shading::Smooth},
+                                                 {"normal-map", render::Shading::NormalMap}});
   }
   if (const Value* v = json::find(root, "outputs")) job.outputs = parseOutputs(*v);
   if (job.outputs.contours && job.method != Method::Silhouette) {
     json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
   }
   if (job.outputs.cage && job.method == Method::Limit) {
-    json::fail("outputs", "output \"cage\" is drawn over a method's own image; method \"limit\" "
-                          "has none");
+    json::fail("outputs",
+               "output \"cage\" is drawn over a method's own image; method \"limit\" "
+               "has none");
   }
   if (job.method != Method::Uniform &&
       (job.params.engine != render::pipeline::Engine::OpenSubdiv || job.params.pushToLimit)) {
-    warnings.push_back("params.engine and params.pushToLimit are read by method \"uniform\" "
-                       "only; ignored");
+    warnings.push_back(
+        "params.engine and params.pushToLimit are read by method \"uniform\" "
+        "only; ignored");
   }
   if (const Value* v = json::find(root, "reference"))
     job.reference = json::boolean(*v, "reference");

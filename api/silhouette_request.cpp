@@ -82,9 +82,8 @@ SilhouetteRequest parseSilhouetteRequest(std::string_view body, std::string_view
     }
     if (const Value* v = json::find(root, "params")) {
       json::requireObject(*v, "params");
-      request::warnUnknownFields(*v, "params",
-                                 {"presubdivide", "searchSteps", "curveSamples", "contour"},
-                                 out.warnings);
+      request::warnUnknownFields(
+          *v, "params", {"presubdivide", "searchSteps", "curveSamples", "contour"}, out.warnings);
       render::pipeline::MethodParams params;
       request::parseSilhouetteParams(*v, limits, params);
       job.params = {params.presubdivide, params.searchSteps, params.curveSamples, params.contour};

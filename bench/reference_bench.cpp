@@ -56,8 +56,9 @@ std::vector<NamedMesh> loadMeshes(const Config& config) {
 
 // Best of `repeat` runs after a warm-up; `beforeEach` runs before every one (e.g. to empty the
 // reference cache so that every run builds its scene).
-RenderResult runBest(const RenderJob& job, render::pipeline::RenderContext& context, int repeat,
-                     const std::function<void()>& beforeEach = [] {}) {
+RenderResult runBest(
+    const RenderJob& job, render::pipeline::RenderContext& context, int repeat,
+    const std::function<void()>& beforeEach = [] {}) {
   render::pipeline::JobLimits limits;
   beforeEach();
   RenderResult best = render::pipeline::run(job, limits, context, {});  // warm-up
@@ -95,11 +96,16 @@ int main(int argc, char** argv) {
       return 2;
     }
     std::string value = argv[++i];
-    if (flag == "--size") config.size = std::stoi(value);
-    else if (flag == "--supersample") config.supersample = std::stoi(value);
-    else if (flag == "--repeat") config.repeat = std::stoi(value);
-    else if (flag == "--corpus") config.corpus = value;
-    else if (flag == "--shapes") config.shapes = bench::splitList(value);
+    if (flag == "--size")
+      config.size = std::stoi(value);
+    else if (flag == "--supersample")
+      config.supersample = std::stoi(value);
+    else if (flag == "--repeat")
+      config.repeat = std::stoi(value);
+    else if (flag == "--corpus")
+      config.corpus = value;
+    else if (flag == "--shapes")
+      config.shapes = bench::splitList(value);
     else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;
@@ -113,10 +119,12 @@ int main(int argc, char** argv) {
               config.size, config.size, config.supersample, config.repeat,
               config.crossCheck ? "; with the Embree subdivision cross-check" : "");
 
-  std::printf("| mesh | faces | adaptive ms | reference ms | ratio | ref. triangles | tessellate | "
-              "BVH | primary rays | Newton+shade | S-mask rays | outline | cross-check | metrics ms | "
-              "cache hit ms | hit ratio | outlineHausdorffPx |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "| mesh | faces | adaptive ms | reference ms | ratio | ref. triangles | tessellate | "
+      "BVH | primary rays | Newton+shade | S-mask rays | outline | cross-check | metrics ms | "
+      "cache hit ms | hit ratio | outlineHausdorffPx |\n");
+  std::printf(
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const NamedMesh& m : loadMeshes(config)) {
     try {
       RenderJob job = adaptiveJob(m, config);
@@ -126,13 +134,14 @@ int main(int argc, char** argv) {
       RenderResult r = runBest(job, context, config.repeat, [&] { cache.clear(); });
       RenderResult hit = runBest(job, context, config.repeat);  // the scene stays cached
       const render::oracle::ReferenceStats& st = *r.timings.reference;
-      std::printf("| %s | %d | %.0f | %.0f | %.2f | %zu | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | "
-                  "%.0f | %.0f | %.0f | %.2f | %.3f |\n",
-                  m.name.c_str(), m.mesh.faceCount(), adaptiveMs, r.timings.referenceMs,
-                  r.timings.referenceMs / adaptiveMs, st.triangles, st.tessellateMs, st.bvhMs,
-                  st.traceMs, st.newtonMs, st.maskMs, st.outlineMs, r.timings.crossCheckMs,
-                  r.timings.metricsMs, hit.timings.referenceMs, hit.timings.referenceMs / adaptiveMs,
-                  r.metrics.silhouette->outlineHausdorffPx.value_or(-1));
+      std::printf(
+          "| %s | %d | %.0f | %.0f | %.2f | %zu | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | "
+          "%.0f | %.0f | %.0f | %.2f | %.3f |\n",
+          m.name.c_str(), m.mesh.faceCount(), adaptiveMs, r.timings.referenceMs,
+          r.timings.referenceMs / adaptiveMs, st.triangles, st.tessellateMs, st.bvhMs, st.traceMs,
+          st.newtonMs, st.maskMs, st.outlineMs, r.timings.crossCheckMs, r.timings.metricsMs,
+          hit.timings.referenceMs, hit.timings.referenceMs / adaptiveMs,
+          r.metrics.silhouette->outlineHausdorffPx.value_or(-1));
     } catch (const std::exception& e) {
       std::printf("| %s | %d | failed: %s |\n", m.name.c_str(), m.mesh.faceCount(), e.what());
     }

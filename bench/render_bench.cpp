@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
-#include <thread>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bench/bench_inputs.h"
@@ -77,10 +77,14 @@ int main(int argc, char** argv) {
   Config config;
   for (int i = 1; i + 1 < argc; i += 2) {
     std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--sizes") config.sizes = parseInts(value);
-    else if (flag == "--repeat") config.repeat = std::stoi(value);
-    else if (flag == "--corpus") config.corpus = value;
-    else if (flag == "--shapes") config.shapes = bench::splitList(value);
+    if (flag == "--sizes")
+      config.sizes = parseInts(value);
+    else if (flag == "--repeat")
+      config.repeat = std::stoi(value);
+    else if (flag == "--corpus")
+      config.corpus = value;
+    else if (flag == "--shapes")
+      config.shapes = bench::splitList(value);
     else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;
@@ -99,7 +103,9 @@ int main(int argc, char** argv) {
   std::vector<NamedMesh> meshes = loadMeshes(config);
 
   std::printf("## Approximations (color+mask+depth+normal, no reference)\n\n");
-  std::printf("| mesh | faces | size | method | triangles | surface ms | approx ms | raster ms | total ms |\n");
+  std::printf(
+      "| mesh | faces | size | method | triangles | surface ms | approx ms | raster ms | total ms "
+      "|\n");
   std::printf("|---|---:|---:|---|---:|---:|---:|---:|---:|\n");
   for (const NamedMesh& m : meshes) {
     for (int size : config.sizes) {
@@ -115,7 +121,8 @@ int main(int argc, char** argv) {
           auto r = runBest(job, context, config.repeat);
           std::printf("| %s | %d | %d | %s | %zu | %.1f | %.1f | %.1f | %.1f |\n", m.name.c_str(),
                       m.mesh.faceCount(), size, v.label.c_str(), r.stats.triangles,
-                      r.timings.surfaceMs, r.timings.approxMs, r.timings.rasterMs, r.timings.totalMs);
+                      r.timings.surfaceMs, r.timings.approxMs, r.timings.rasterMs,
+                      r.timings.totalMs);
         } catch (const std::exception& e) {
           std::printf("| %s | %d | %d | %s | failed: %s |||||\n", m.name.c_str(),
                       m.mesh.faceCount(), size, v.label.c_str(), e.what());
@@ -125,10 +132,12 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("\n## Reference and metrics (adaptive dr1 with reference: true, S = 4, "
-              "referenceCrossCheck: true)\n\n");
-  std::printf("| mesh | size | reference triangles | reference ms | metrics ms | total ms | "
-              "hausdorffPx | crossCheckPx |\n");
+  std::printf(
+      "\n## Reference and metrics (adaptive dr1 with reference: true, S = 4, "
+      "referenceCrossCheck: true)\n\n");
+  std::printf(
+      "| mesh | size | reference triangles | reference ms | metrics ms | total ms | "
+      "hausdorffPx | crossCheckPx |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const NamedMesh& m : meshes) {
     for (int size : config.sizes) {

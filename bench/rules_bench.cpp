@@ -16,6 +16,8 @@
 // Each time is the minimum of --repeat runs (default 5; 2 above a million faces).
 //
 //   rules_bench [--repeat N] [--max-faces N] [--corpus DIR]
+#include <opensubdiv/far/primvarRefiner.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,8 +28,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <opensubdiv/far/primvarRefiner.h>
 
 #include "api/obj_reader.h"
 #include "render/rules/limit.h"
@@ -99,9 +99,9 @@ double minMs(int repeat, const std::function<void()>& work) {
   for (int r = 0; r < repeat; ++r) {
     auto start = std::chrono::steady_clock::now();
     work();
-    best = std::min(best,
-                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                        .count());
+    best = std::min(
+        best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                  .count());
   }
   return best;
 }
@@ -144,13 +144,17 @@ int main(int argc, char** argv) {
   Config config;
   for (int i = 1; i + 1 < argc; i += 2) {
     std::string flag = argv[i];
-    if (flag == "--repeat") config.repeat = std::stoi(argv[i + 1]);
-    else if (flag == "--max-faces") config.maxFaces = std::stod(argv[i + 1]);
-    else if (flag == "--corpus") config.corpus = argv[i + 1];
+    if (flag == "--repeat")
+      config.repeat = std::stoi(argv[i + 1]);
+    else if (flag == "--max-faces")
+      config.maxFaces = std::stod(argv[i + 1]);
+    else if (flag == "--corpus")
+      config.corpus = argv[i + 1];
   }
 
-  std::printf("| shape | level | faces | OpenSubdiv ms | masks ms | masks / OSD | factored ms | "
-              "factored / OSD | OSD limit ms | own limit ms | own / OSD |\n");
+  std::printf(
+      "| shape | level | faces | OpenSubdiv ms | masks ms | masks / OSD | factored ms | "
+      "factored / OSD | OSD limit ms | own limit ms | own / OSD |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const NamedMesh& shape : loadMeshes(config)) {
     const bool factored =
@@ -176,9 +180,8 @@ int main(int argc, char** argv) {
       FarRun run = farRefine(shape.mesh, level);
       const int n = run.refiner->GetLevel(level).GetNumVertices();
       std::vector<Point> limit(n), tan1(n), tan2(n);
-      double farLimit = minMs(repeat, [&] {
-        Far::PrimvarRefiner(*run.refiner).Limit(run.last, limit, tan1, tan2);
-      });
+      double farLimit = minMs(
+          repeat, [&] { Far::PrimvarRefiner(*run.refiner).Limit(run.last, limit, tan1, tan2); });
       render::rules::Level own =
           render::rules::refineUniform(shape.mesh, level, render::rules::Method::Masks);
       double ownLimit = minMs(repeat, [&] { render::rules::limitOf(own); });

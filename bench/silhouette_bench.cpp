@@ -103,7 +103,8 @@ Camera obliqueCamera(const Bounds& bounds, int size) {
 }
 
 double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 struct Row {
@@ -173,8 +174,9 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, Build>> methods;
     methods.push_back({"coarse", [&] { return tessellate::tessellateCoarse(*surface); }});
     for (int level = 1; level <= 5; ++level) {
-      methods.push_back({"uniform L" + std::to_string(level),
-                         [&, level] { return tessellate::tessellateUniform(*surface, level, 8'000'000); }});
+      methods.push_back({"uniform L" + std::to_string(level), [&, level] {
+                           return tessellate::tessellateUniform(*surface, level, 8'000'000);
+                         }});
     }
     methods.push_back({"adaptive dr1", [&] {
                          tessellate::AdaptiveOptions o;
@@ -211,10 +213,10 @@ int main(int argc, char** argv) {
         }
         row.ms = best;
         row.triangles = mesh.triangleCount();
-        ImageSet images = rasterizer.render(mesh, camera, PassSelection{.mask = true, .supersample = S},
-                                            Shading::Smooth);
-        metrics::SilhouetteMetrics m =
-            metrics::compareSilhouettes(images.supersampledMask, reference.images.supersampledMask, S);
+        ImageSet images = rasterizer.render(
+            mesh, camera, PassSelection{.mask = true, .supersample = S}, Shading::Smooth);
+        metrics::SilhouetteMetrics m = metrics::compareSilhouettes(
+            images.supersampledMask, reference.images.supersampledMask, S);
         row.hausdorffPx = m.hausdorffPx;
         row.meanPx = m.meanPx;
       } catch (const std::exception& e) {
@@ -258,8 +260,9 @@ int main(int argc, char** argv) {
   }
 
   std::printf("## Summary\n\n");
-  std::printf("| shape | class | exact px | pn px | exact tris | uniform reaching it | its tris | "
-              "tris ratio | exact ms | uniform ms |\n");
+  std::printf(
+      "| shape | class | exact px | pn px | exact tris | uniform reaching it | its tris | "
+      "tris ratio | exact ms | uniform ms |\n");
   std::printf("|---|---|---:|---:|---:|---|---:|---:|---:|---:|\n");
   for (const Summary& s : summaries) {
     if (s.uniformMatch.empty()) {

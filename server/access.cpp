@@ -44,7 +44,8 @@ std::optional<api::Answer> Access::preflight(std::string_view origin) const {
   answer.status = 204;
   answer.contentType = "text/plain";
   answer.headers.emplace_back("Access-Control-Allow-Methods", "GET, POST, OPTIONS");
-  answer.headers.emplace_back("Access-Control-Allow-Headers", "Content-Type, Authorization, Accept");
+  answer.headers.emplace_back("Access-Control-Allow-Headers",
+                              "Content-Type, Authorization, Accept");
   answer.headers.emplace_back("Access-Control-Max-Age", "600");
   return answer;
 }

@@ -41,7 +41,6 @@ class Access {
   bool originAllowed(std::string_view origin) const;
 
  private:
-
   AccessOptions options_;
 };
 

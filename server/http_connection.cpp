@@ -134,8 +134,10 @@ void Connection::handle() {
   auto message = parser_->release();
   bool keepAlive = message.keep_alive();
   bytesIn_ = message.body().size();
-  Request request{std::string(message.method_string()), std::string(message.target()),
-                  std::move(message.body()), std::string(message[http::field::accept]),
+  Request request{std::string(message.method_string()),
+                  std::string(message.target()),
+                  std::move(message.body()),
+                  std::string(message[http::field::accept]),
                   std::string(message[http::field::authorization]),
                   std::string(message[http::field::origin])};
   // The router may answer from a worker thread: hop back onto this connection's strand.

@@ -3,8 +3,8 @@
 #include <unistd.h>
 
 #include <csignal>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -173,7 +173,8 @@ int serve(const CommandLine& cl) {
 
   server::AccessOptions access{config->authToken, config->corsOrigins};
   if (access.authToken.empty()) {
-    if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token) access.authToken = token;
+    if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token)
+      access.authToken = token;
   }
   server::Router router(config->limits, pool, access, config->logLevel);
   server::HttpOptions httpOptions;

@@ -25,7 +25,8 @@ spdlog::level::level_enum levelOf(std::string_view name) {
 // beyond refusing what could break the line.
 std::string safe(std::string_view text) {
   std::string out;
-  for (char c : text) out += (c == '"' || c == '\\' || static_cast<unsigned char>(c) < 0x20) ? '?' : c;
+  for (char c : text)
+    out += (c == '"' || c == '\\' || static_cast<unsigned char>(c) < 0x20) ? '?' : c;
   return out;
 }
 

@@ -24,7 +24,7 @@ struct Route {
 // Every (path, method) limn answers; a known path with another method is a 405 listing these.
 constexpr Route kRoutes[] = {
     {"/healthz", "GET"},      {"/readyz", "GET"},     {"/metrics", "GET"},
-    {"/openapi.json", "GET"}, {"/v1/render", "POST"},  {"/v1/silhouette", "POST"},
+    {"/openapi.json", "GET"}, {"/v1/render", "POST"}, {"/v1/silhouette", "POST"},
 };
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
@@ -265,7 +265,8 @@ api::Answer Router::metrics() const {
            "# TYPE limn_reference_cache_lookups_total counter\n"
         << "limn_reference_cache_lookups_total{result=\"hit\"} " << c.hits << "\n"
         << "limn_reference_cache_lookups_total{result=\"miss\"} " << c.misses << "\n"
-        << "# HELP limn_reference_cache_evictions_total Reference scenes evicted to stay in bounds.\n"
+        << "# HELP limn_reference_cache_evictions_total Reference scenes evicted to stay in "
+           "bounds.\n"
            "# TYPE limn_reference_cache_evictions_total counter\n"
         << "limn_reference_cache_evictions_total " << c.evictions << "\n"
         << "# HELP limn_reference_cache_entries Reference scenes held.\n"

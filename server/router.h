@@ -40,8 +40,8 @@ class Router {
  public:
   using Reply = std::function<void(api::Answer)>;
 
-  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool,
-         AccessOptions access = {}, const std::string& logLevel = "info");
+  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, AccessOptions access = {},
+         const std::string& logLevel = "info");
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
   // the pool's watchdog for renders.

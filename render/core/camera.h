@@ -32,8 +32,8 @@ struct Ray {
 
 class Camera {
  public:
-  Camera(Vec3 eye, Vec3 target, Vec3 up, double fovYDeg, Projection projection,
-         double orthoHeight, int width, int height, double nearPlane, double farPlane);
+  Camera(Vec3 eye, Vec3 target, Vec3 up, double fovYDeg, Projection projection, double orthoHeight,
+         int width, int height, double nearPlane, double farPlane);
 
   // The same view at `factor` times the resolution in each direction (for supersampled masks).
   Camera scaled(int factor) const;

@@ -34,7 +34,7 @@ inline constexpr const char* kDepth = "depth";          // 1 channel, linear dep
 inline constexpr const char* kNormal = "normal";        // 3 channels, unit world normal
 inline constexpr const char* kWireframe = "wireframe";  // RGBA, colour with edges drawn over
 inline constexpr const char* kContours = "contours";    // RGBA, colour with the contour drawn over
-inline constexpr const char* kCage = "cage";            // RGBA, colour with the control cage drawn over
+inline constexpr const char* kCage = "cage";  // RGBA, colour with the control cage drawn over
 }  // namespace pass
 
 // The passes of one rendering (approximation or reference) of one camera.

@@ -28,7 +28,8 @@ class Digest {
   template <typename T>
   void addVector(const std::vector<T>& values) {
     add(values.size());
-    if (!values.empty()) XXH3_128bits_update(state_.get(), values.data(), values.size() * sizeof(T));
+    if (!values.empty())
+      XXH3_128bits_update(state_.get(), values.data(), values.size() * sizeof(T));
   }
   std::string hex() const {
     XXH128_hash_t h = XXH3_128bits_digest(state_.get());

@@ -16,9 +16,9 @@ namespace {
 }
 
 [[noreturn]] void overLimit(const std::string& limit, long value, long max) {
-  throw InputError(InputError::Kind::LimitExceeded, limit,
-                   "mesh exceeds limit " + limit + ": " + std::to_string(value) + " > " +
-                       std::to_string(max));
+  throw InputError(
+      InputError::Kind::LimitExceeded, limit,
+      "mesh exceeds limit " + limit + ": " + std::to_string(value) + " > " + std::to_string(max));
 }
 
 uint64_t edgeKey(int a, int b) {
@@ -27,8 +27,8 @@ uint64_t edgeKey(int a, int b) {
 }
 
 void checkSharpness(float s, const std::string& subject) {
-  if (!std::isfinite(s) || s < 0) invalid(subject, subject + " has sharpness " + std::to_string(s) +
-                                                       ": must be finite and >= 0");
+  if (!std::isfinite(s) || s < 0)
+    invalid(subject, subject + " has sharpness " + std::to_string(s) + ": must be finite and >= 0");
 }
 
 // The number of face corners at each vertex (its valence on a closed manifold) against the
@@ -57,9 +57,12 @@ Bounds ControlMesh::bounds() const {
 
 const char* schemeName(Scheme scheme) {
   switch (scheme) {
-    case Scheme::CatmullClark: return "catmull-clark";
-    case Scheme::Loop: return "loop";
-    case Scheme::Bilinear: return "bilinear";
+    case Scheme::CatmullClark:
+      return "catmull-clark";
+    case Scheme::Loop:
+      return "loop";
+    case Scheme::Bilinear:
+      return "bilinear";
   }
   return "?";
 }
@@ -74,8 +77,8 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
 
   for (int v = 0; v < mesh.vertexCount(); ++v) {
     if (!isFinite(mesh.points[v])) {
-      invalid("vertex " + std::to_string(v), "vertex " + std::to_string(v) +
-                                                 " has a non-finite coordinate");
+      invalid("vertex " + std::to_string(v),
+              "vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
   }
 
@@ -87,7 +90,8 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
     if (n < 3) invalid(face, face + " has " + std::to_string(n) + " vertices: at least 3 needed");
     if (n > limits.maxFaceSize) {
       throw InputError(InputError::Kind::LimitExceeded, "maxFaceSize",
-                       face + " has " + std::to_string(n) + " vertices: exceeds limit maxFaceSize " +
+                       face + " has " + std::to_string(n) +
+                           " vertices: exceeds limit maxFaceSize " +
                            std::to_string(limits.maxFaceSize));
     }
     if (mesh.scheme == Scheme::Loop && n != 3) {
@@ -95,9 +99,9 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
                         " vertices: the loop scheme takes triangles only");
     }
     if (offset + n > mesh.faceVertexIndices.size()) {
-      invalid("faceVertexIndices", "faceVertexIndices has " +
-                                       std::to_string(mesh.faceVertexIndices.size()) +
-                                       " entries but faceVertexCounts needs more (at " + face + ")");
+      invalid("faceVertexIndices",
+              "faceVertexIndices has " + std::to_string(mesh.faceVertexIndices.size()) +
+                  " entries but faceVertexCounts needs more (at " + face + ")");
     }
     // A face may repeat a vertex (the corpus's non-manifold shapes do): OpenSubdiv accepts
     // such faces as non-manifold topology, so limn does too.
@@ -115,10 +119,9 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
     offset += n;
   }
   if (offset != mesh.faceVertexIndices.size()) {
-    invalid("faceVertexIndices", "faceVertexIndices has " +
-                                     std::to_string(mesh.faceVertexIndices.size()) +
-                                     " entries but faceVertexCounts sums to " +
-                                     std::to_string(offset));
+    invalid("faceVertexIndices",
+            "faceVertexIndices has " + std::to_string(mesh.faceVertexIndices.size()) +
+                " entries but faceVertexCounts sums to " + std::to_string(offset));
   }
   checkValence(mesh, limits.maxValence);
 

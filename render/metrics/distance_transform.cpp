@@ -2,13 +2,13 @@
 // squaredDistanceTransform() of metrics.h built from the two.
 #include "render/metrics/distance_transform.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
 #include <string>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "render/metrics/metrics.h"
 
@@ -37,26 +37,28 @@ void ColumnDistances::compute(const uint8_t* pixels, uint8_t featureBits) {
   const uint16_t none = static_cast<uint16_t>(height_);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, w, kColumnStripe),
                     [&](const tbb::blocked_range<size_t>& stripe) {
-    const size_t x0 = stripe.begin(), x1 = stripe.end();
-    for (size_t x = x0; x < x1; ++x) distances_[x] = (pixels[x] & featureBits) ? 0 : none;
-    for (size_t y = 1; y < static_cast<size_t>(height_); ++y) {
-      const uint8_t* f = pixels + y * w;
-      uint16_t* d = distances_.get() + y * w;
-      const uint16_t* above = d - w;
-      for (size_t x = x0; x < x1; ++x) {
-        // Computed in int: at height 65535, none + 1 does not fit 16 bits.
-        const uint16_t next = static_cast<uint16_t>(std::min<int>(above[x] + 1, none));
-        d[x] = (f[x] & featureBits) ? 0 : next;
-      }
-    }
-    for (size_t y = static_cast<size_t>(height_) - 1; y-- > 0;) {
-      uint16_t* d = distances_.get() + y * w;
-      const uint16_t* below = d + w;
-      for (size_t x = x0; x < x1; ++x) {
-        d[x] = static_cast<uint16_t>(std::min<int>(d[x], below[x] + 1));
-      }
-    }
-  });
+                      const size_t x0 = stripe.begin(), x1 = stripe.end();
+                      for (size_t x = x0; x < x1; ++x)
+                        distances_[x] = (pixels[x] & featureBits) ? 0 : none;
+                      for (size_t y = 1; y < static_cast<size_t>(height_); ++y) {
+                        const uint8_t* f = pixels + y * w;
+                        uint16_t* d = distances_.get() + y * w;
+                        const uint16_t* above = d - w;
+                        for (size_t x = x0; x < x1; ++x) {
+                          // Computed in int: at height 65535, none + 1 does not fit 16 bits.
+                          const uint16_t next =
+                              static_cast<uint16_t>(std::min<int>(above[x] + 1, none));
+                          d[x] = (f[x] & featureBits) ? 0 : next;
+                        }
+                      }
+                      for (size_t y = static_cast<size_t>(height_) - 1; y-- > 0;) {
+                        uint16_t* d = distances_.get() + y * w;
+                        const uint16_t* below = d + w;
+                        for (size_t x = x0; x < x1; ++x) {
+                          d[x] = static_cast<uint16_t>(std::min<int>(d[x], below[x] + 1));
+                        }
+                      }
+                    });
 }
 
 bool RowEnvelope::build(const ColumnDistances& columns, int y) {
@@ -119,14 +121,16 @@ std::vector<double> squaredDistanceTransform(const std::vector<bool>& isFeature,
   std::vector<double> result(features.size(), std::numeric_limits<double>::infinity());
   tbb::parallel_for(tbb::blocked_range<int>(0, height, kRowGrain),
                     [&](const tbb::blocked_range<int>& rows) {
-    RowEnvelope envelope;
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      // No feature in this row's envelope means none in the image: leave +infinity.
-      if (!envelope.build(columns, y)) continue;
-      double* out = result.data() + static_cast<size_t>(y) * width;
-      for (int x = 0; x < width; ++x) out[x] = static_cast<double>(envelope.squaredDistanceAt(x));
-    }
-  });
+                      RowEnvelope envelope;
+                      for (int y = rows.begin(); y < rows.end(); ++y) {
+                        // No feature in this row's envelope means none in the image: leave
+                        // +infinity.
+                        if (!envelope.build(columns, y)) continue;
+                        double* out = result.data() + static_cast<size_t>(y) * width;
+                        for (int x = 0; x < width; ++x)
+                          out[x] = static_cast<double>(envelope.squaredDistanceAt(x));
+                      }
+                    });
   return result;
 }
 

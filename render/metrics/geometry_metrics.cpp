@@ -1,5 +1,8 @@
 // measureGeometry(): how far an approximation's triangles are from the limit surface, in world
 // units, at points whose place on the limit surface is known.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -7,9 +10,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "render/metrics/metrics.h"
 
@@ -37,12 +37,12 @@ Partial reduceInChunks(size_t items, PerItem&& perItem) {
   std::vector<Partial> partials(chunks);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1),
                     [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t c = range.begin(); c < range.end(); ++c) {
-      Partial& p = partials[c];
-      const size_t end = std::min(items, (c + 1) * kChunk);
-      for (size_t i = c * kChunk; i < end; ++i) perItem(i, p);
-    }
-  });
+                      for (size_t c = range.begin(); c < range.end(); ++c) {
+                        Partial& p = partials[c];
+                        const size_t end = std::min(items, (c + 1) * kChunk);
+                        for (size_t i = c * kChunk; i < end; ++i) perItem(i, p);
+                      }
+                    });
   Partial total;
   for (const Partial& p : partials) {
     total.max = std::max(total.max, p.max);
@@ -106,8 +106,7 @@ Partial measureTriangles(const tessellate::TriangleMesh& mesh,
   }
   auto sameParameters = [&](size_t c, size_t d) {
     return mesh.triangleFaces[c / 3] == mesh.triangleFaces[d / 3] &&
-           mesh.cornerUVs[c].x == mesh.cornerUVs[d].x &&
-           mesh.cornerUVs[c].y == mesh.cornerUVs[d].y;
+           mesh.cornerUVs[c].x == mesh.cornerUVs[d].x && mesh.cornerUVs[c].y == mesh.cornerUVs[d].y;
   };
   auto cornerDistance = [&](size_t c) {
     const Vec2f uv = mesh.cornerUVs[c];
@@ -119,13 +118,13 @@ Partial measureTriangles(const tessellate::TriangleMesh& mesh,
   std::vector<double> vertexDistance(vertices, 0.0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices, kChunk),
                     [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t v = range.begin(); v < range.end(); ++v) {
-      const uint32_t c = firstCorner[v];
-      if (c != kUnused && surface.hasLimit(mesh.triangleFaces[c / 3])) {
-        vertexDistance[v] = cornerDistance(c);
-      }
-    }
-  });
+                      for (size_t v = range.begin(); v < range.end(); ++v) {
+                        const uint32_t c = firstCorner[v];
+                        if (c != kUnused && surface.hasLimit(mesh.triangleFaces[c / 3])) {
+                          vertexDistance[v] = cornerDistance(c);
+                        }
+                      }
+                    });
 
   // Bfr parameterisations are the same for every call on a face; look them up once.
   std::vector<OpenSubdiv::Bfr::Parameterization> params(surface.faceCount());

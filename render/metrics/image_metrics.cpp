@@ -17,16 +17,14 @@ namespace {
 constexpr double kMaxPsnr = 100.0;
 constexpr double kPi = 3.14159265358979323846;
 
-const Image& requirePass(const ImageSet& set, const char* name, int minChannels,
-                         const char* side) {
+const Image& requirePass(const ImageSet& set, const char* name, int minChannels, const char* side) {
   const Image* image = set.find(name);
   if (!image) {
     throw std::invalid_argument(std::string("metrics: the ") + side + " images have no '" + name +
                                 "' pass");
   }
   if (image->channels < minChannels ||
-      image->pixels.size() !=
-          static_cast<size_t>(image->width) * image->height * image->channels) {
+      image->pixels.size() != static_cast<size_t>(image->width) * image->height * image->channels) {
     throw std::invalid_argument(std::string("metrics: the ") + side + " '" + name +
                                 "' pass needs at least " + std::to_string(minChannels) +
                                 " channels");
@@ -97,8 +95,8 @@ ColorMetrics compareColor(const ImageSet& approx, const ImageSet& reference) {
   ColorMetrics result;
   result.rmse = pixels == 0 ? 0.0 : std::sqrt(sumSquared / (3.0 * static_cast<double>(pixels)));
   // Peak value 1 (colours in [0,1]); capped so identical images give a finite number.
-  result.psnr = result.rmse > 0 ? std::min(kMaxPsnr, 20.0 * std::log10(1.0 / result.rmse))
-                                : kMaxPsnr;
+  result.psnr =
+      result.rmse > 0 ? std::min(kMaxPsnr, 20.0 * std::log10(1.0 / result.rmse)) : kMaxPsnr;
   return result;
 }
 

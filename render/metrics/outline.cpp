@@ -44,9 +44,7 @@ uint32_t compact(uint64_t v) {
 struct SampleGrid {
   int width, height, supersample;
 
-  Vec2 position(int i, int j) const {
-    return {(i + 0.5) / supersample, (j + 0.5) / supersample};
-  }
+  Vec2 position(int i, int j) const { return {(i + 0.5) / supersample, (j + 0.5) / supersample}; }
   uint64_t sample(int i, int j) const {
     return interleave(static_cast<uint32_t>(i), static_cast<uint32_t>(j));
   }

@@ -7,8 +7,9 @@
 // such a cell whose two samples differ, the crossing is found by bisection with a coverage
 // query on the geometry itself (a ray cast, not the mask), the crossings of each cell are
 // joined into segments as marching squares joins them, and where the polyline turns sharply the
-// segments' middles are moved onto the outline the same way (so corners are not cut off). See docs/engine.md "Continuous outline
-// distances" for the definition, the image border and one-sided outlines.
+// segments' middles are moved onto the outline the same way (so corners are not cut off). See
+// docs/engine.md "Continuous outline distances" for the definition, the image border and one-sided
+// outlines.
 #pragma once
 
 #include <functional>
@@ -28,7 +29,7 @@ using CoverageQuery =
     std::function<void(const std::vector<Vec2>& points, std::vector<char>& covered)>;
 
 struct Outline {
-  std::vector<Vec2> points;             // located crossings, output pixels
+  std::vector<Vec2> points;                   // located crossings, output pixels
   std::vector<std::pair<int, int>> segments;  // indices into points
   // The frame points are measured in: the rectangle of output pixel centres, [0.5, w - 0.5] x
   // [0.5, h - 0.5], which every supersampling's sample grid covers (a finer grid reaches closer
@@ -56,8 +57,9 @@ struct OutlineDistances {
 };
 
 // Distances between two outlines: every located point of one inside its frame is measured to the
-// nearest segment (or lone point) of the other, wherever that lies. Empty outlines: nothing when both are empty is 0; when only one
-// is, the answer is `farPx` (the image diagonal) for both numbers, as for the mask metrics.
+// nearest segment (or lone point) of the other, wherever that lies. Empty outlines: nothing when
+// both are empty is 0; when only one is, the answer is `farPx` (the image diagonal) for both
+// numbers, as for the mask metrics.
 OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx);
 
 }  // namespace limn::render::metrics

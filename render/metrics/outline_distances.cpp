@@ -62,13 +62,15 @@ class SegmentIndex {
         for (int x = cx - ring; x <= cx + ring; x += edgeRow ? 1 : 2 * std::max(ring, 1)) {
           if (x < 0 || x >= nx_) continue;
           size_t cell = static_cast<size_t>(y) * nx_ + x;
-          for (int k = start_[cell]; k < start_[cell + 1]; ++k) best = std::min(best, distance(p, entries_[k]));
+          for (int k = start_[cell]; k < start_[cell + 1]; ++k)
+            best = std::min(best, distance(p, entries_[k]));
         }
       }
       // Items in rings further out are at least `ring` cells away.
       if (best <= ring * cell_) return best;
     }
-    for (size_t k = 0; k < items_.size(); ++k) best = std::min(best, distance(p, static_cast<int>(k)));
+    for (size_t k = 0; k < items_.size(); ++k)
+      best = std::min(best, distance(p, static_cast<int>(k)));
     return best;
   }
 
@@ -111,8 +113,9 @@ std::vector<double> directedDistances(const Outline& from, const SegmentIndex& i
   std::vector<double> d(measured.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, d.size(), 256),
                     [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k < r.end(); ++k) d[k] = index.nearest(measured[k]);
-  });
+                      for (size_t k = r.begin(); k < r.end(); ++k)
+                        d[k] = index.nearest(measured[k]);
+                    });
   return d;
 }
 

@@ -9,6 +9,9 @@
 //      envelopes only on the rows where the other contour has pixels.
 // Every pass runs in parallel over rows or column stripes; per-row partial results are summed
 // in row order afterwards, so the numbers do not depend on the thread count.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -16,9 +19,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "render/metrics/distance_transform.h"
 #include "render/metrics/metrics.h"
@@ -72,54 +72,54 @@ Classified classify(const Image& a, const Image& b, int s) {
   std::vector<long> bandBoth(outHeight, 0), bandEither(outHeight, 0), bandMismatch(outHeight, 0);
 
   const int bandGrain = std::max(1, kRowGrain / s);
-  tbb::parallel_for(tbb::blocked_range<int>(0, outHeight, bandGrain),
-                    [&](const tbb::blocked_range<int>& bands) {
-    std::vector<uint8_t> ring(3 * (w + 2), 0);  // one uncovered pixel either side of each row
-    uint8_t* rows[3] = {ring.data() + 1, ring.data() + w + 3, ring.data() + 2 * w + 5};
-    std::vector<int> countA(outWidth), countB(outWidth);
-    const int y0 = bands.begin() * s;
-    coverRow(a, b, y0 - 1, rows[0]);
-    coverRow(a, b, y0, rows[1]);
-    for (int oy = bands.begin(); oy < bands.end(); ++oy) {
-      std::fill(countA.begin(), countA.end(), 0);
-      std::fill(countB.begin(), countB.end(), 0);
-      long both = 0, either = 0;
-      for (int y = oy * s; y < (oy + 1) * s; ++y) {
-        coverRow(a, b, y + 1, rows[2]);
-        const uint8_t *up = rows[0], *here = rows[1], *down = rows[2];
-        uint8_t* out = result.pixels.get() + static_cast<size_t>(y) * w;
-        uint8_t rowAny = 0;
-        for (size_t x = 0; x < w; ++x) {
-          // Bits set where all four neighbours are covered too.
-          const uint8_t inside = here[x] & up[x] & down[x] & here[x - 1] & here[x + 1];
-          const uint8_t contour = static_cast<uint8_t>((here[x] & ~inside) << 2);
-          out[x] = here[x] | contour;
-          rowAny |= contour;
-          both += here[x] == (kCoveredA | kCoveredB);
-          either += here[x] != 0;
-        }
-        result.rowContours[y] = rowAny;
-        for (int ox = 0; ox < outWidth; ++ox) {
-          const uint8_t* block = here + static_cast<size_t>(ox) * s;
-          int ca = 0, cb = 0;
-          for (int k = 0; k < s; ++k) {
-            ca += block[k] & kCoveredA;
-            cb += (block[k] & kCoveredB) >> 1;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, outHeight, bandGrain), [&](const tbb::blocked_range<int>& bands) {
+        std::vector<uint8_t> ring(3 * (w + 2), 0);  // one uncovered pixel either side of each row
+        uint8_t* rows[3] = {ring.data() + 1, ring.data() + w + 3, ring.data() + 2 * w + 5};
+        std::vector<int> countA(outWidth), countB(outWidth);
+        const int y0 = bands.begin() * s;
+        coverRow(a, b, y0 - 1, rows[0]);
+        coverRow(a, b, y0, rows[1]);
+        for (int oy = bands.begin(); oy < bands.end(); ++oy) {
+          std::fill(countA.begin(), countA.end(), 0);
+          std::fill(countB.begin(), countB.end(), 0);
+          long both = 0, either = 0;
+          for (int y = oy * s; y < (oy + 1) * s; ++y) {
+            coverRow(a, b, y + 1, rows[2]);
+            const uint8_t *up = rows[0], *here = rows[1], *down = rows[2];
+            uint8_t* out = result.pixels.get() + static_cast<size_t>(y) * w;
+            uint8_t rowAny = 0;
+            for (size_t x = 0; x < w; ++x) {
+              // Bits set where all four neighbours are covered too.
+              const uint8_t inside = here[x] & up[x] & down[x] & here[x - 1] & here[x + 1];
+              const uint8_t contour = static_cast<uint8_t>((here[x] & ~inside) << 2);
+              out[x] = here[x] | contour;
+              rowAny |= contour;
+              both += here[x] == (kCoveredA | kCoveredB);
+              either += here[x] != 0;
+            }
+            result.rowContours[y] = rowAny;
+            for (int ox = 0; ox < outWidth; ++ox) {
+              const uint8_t* block = here + static_cast<size_t>(ox) * s;
+              int ca = 0, cb = 0;
+              for (int k = 0; k < s; ++k) {
+                ca += block[k] & kCoveredA;
+                cb += (block[k] & kCoveredB) >> 1;
+              }
+              countA[ox] += ca;
+              countB[ox] += cb;
+            }
+            std::rotate(rows, rows + 1, rows + 3);
           }
-          countA[ox] += ca;
-          countB[ox] += cb;
+          long mismatched = 0;
+          for (int ox = 0; ox < outWidth; ++ox) {
+            mismatched += (countA[ox] > majority) != (countB[ox] > majority);
+          }
+          bandBoth[oy] = both;
+          bandEither[oy] = either;
+          bandMismatch[oy] = mismatched;
         }
-        std::rotate(rows, rows + 1, rows + 3);
-      }
-      long mismatched = 0;
-      for (int ox = 0; ox < outWidth; ++ox) {
-        mismatched += (countA[ox] > majority) != (countB[ox] > majority);
-      }
-      bandBoth[oy] = both;
-      bandEither[oy] = either;
-      bandMismatch[oy] = mismatched;
-    }
-  });
+      });
 
   long both = 0, either = 0;
   for (int oy = 0; oy < outHeight; ++oy) {
@@ -146,26 +146,26 @@ DirectedDistances directedDistances(const Classified& flags, uint8_t fromBit,
   std::vector<long> rowCount(height, 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, height, kRowGrain),
                     [&](const tbb::blocked_range<int>& rows) {
-    RowEnvelope envelope;
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      if (!(flags.rowContours[y] & fromBit)) continue;
-      const uint8_t* row = flags.pixels.get() + static_cast<size_t>(y) * width;
-      envelope.build(to, y);
-      int64_t worst = 0;
-      double sum = 0;
-      long count = 0;
-      for (int x = 0; x < width; ++x) {
-        if (!(row[x] & fromBit)) continue;
-        const int64_t d2 = envelope.squaredDistanceAt(x);
-        worst = std::max(worst, d2);
-        sum += std::sqrt(static_cast<double>(d2));
-        ++count;
-      }
-      rowMax[y] = std::sqrt(static_cast<double>(worst));
-      rowSum[y] = sum;
-      rowCount[y] = count;
-    }
-  });
+                      RowEnvelope envelope;
+                      for (int y = rows.begin(); y < rows.end(); ++y) {
+                        if (!(flags.rowContours[y] & fromBit)) continue;
+                        const uint8_t* row = flags.pixels.get() + static_cast<size_t>(y) * width;
+                        envelope.build(to, y);
+                        int64_t worst = 0;
+                        double sum = 0;
+                        long count = 0;
+                        for (int x = 0; x < width; ++x) {
+                          if (!(row[x] & fromBit)) continue;
+                          const int64_t d2 = envelope.squaredDistanceAt(x);
+                          worst = std::max(worst, d2);
+                          sum += std::sqrt(static_cast<double>(d2));
+                          ++count;
+                        }
+                        rowMax[y] = std::sqrt(static_cast<double>(worst));
+                        rowSum[y] = sum;
+                        rowCount[y] = count;
+                      }
+                    });
   DirectedDistances total;
   for (int y = 0; y < height; ++y) {
     total.max = std::max(total.max, rowMax[y]);

@@ -87,8 +87,7 @@ PixelRay pixelRay(const Camera& camera, double px, double py) {
   Ray ray = camera.rayThrough(px, py);
   // Depth along the view is t * cos(angle to the forward axis): clip at near and far depth.
   double cosine = dot(ray.direction, camera.forward());
-  PixelRay r{ray.origin, ray.direction, camera.nearPlane() / cosine,
-             camera.farPlane() / cosine};
+  PixelRay r{ray.origin, ray.direction, camera.nearPlane() / cosine, camera.farPlane() / cosine};
   if (camera.projection() == Projection::Perspective) r.tNear = std::max(r.tNear, 0.0);
   return r;
 }
@@ -216,22 +215,22 @@ void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2
   covered.assign(points.size(), 0);
   const size_t packets = (points.size() + 15) / 16;
   std::atomic<bool> cancelled{false};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, packets, 64),
-                    [&](const tbb::blocked_range<size_t>& r) {
-    if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
-      cancelled = true;
-      return;
-    }
-    FlushDenormalsScope ftz;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    for (size_t p = r.begin(); p < r.end(); ++p) {
-      const size_t first = 16 * p;
-      const int count = static_cast<int>(std::min<size_t>(16, points.size() - first));
-      uint32_t hits = occludedLanes(scene, camera, points.data() + first, count, context);
-      for (int k = 0; k < count; ++k) covered[first + k] = (hits >> k) & 1;
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, packets, 64), [&](const tbb::blocked_range<size_t>& r) {
+        if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
+          cancelled = true;
+          return;
+        }
+        FlushDenormalsScope ftz;
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        for (size_t p = r.begin(); p < r.end(); ++p) {
+          const size_t first = 16 * p;
+          const int count = static_cast<int>(std::min<size_t>(16, points.size() - first));
+          uint32_t hits = occludedLanes(scene, camera, points.data() + first, count, context);
+          for (int k = 0; k < count; ++k) covered[first + k] = (hits >> k) & 1;
+        }
+      });
   if (cancelled) throw Cancelled();
 }
 

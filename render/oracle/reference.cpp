@@ -7,14 +7,14 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "render/core/shading.h"
 #include "render/oracle/ray_caster.h"
-#include "render/oracle/reference_tessellation.h"
 #include "render/oracle/reference_scene.h"
+#include "render/oracle/reference_tessellation.h"
 #include "render/oracle/surface_hit.h"
 #include "render/oracle/triangle_scene.h"
 
@@ -78,41 +78,47 @@ struct PassImages {
 // on a border. The coverage of a triangle mesh changes only across an edge between a front- and
 // a back-facing triangle, or across a boundary edge, and at least one triangle at each such
 // edge is marked: so a thin spike or sliver between pixel centres is not missed.
-std::vector<char> outlineCandidates(const ReferenceTessellation& tessellation, const Camera& camera) {
+std::vector<char> outlineCandidates(const ReferenceTessellation& tessellation,
+                                    const Camera& camera) {
   const tessellate::TriangleMesh& mesh = tessellation.mesh;
   const int width = camera.width(), height = camera.height();
   std::vector<char> marked(static_cast<size_t>(width) * height, 0);
   auto toVec3 = [](const Vec3f& v) { return Vec3{v.x, v.y, v.z}; };
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.triangleCount(), 4096),
-                    [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t t = r.begin(); t < r.end(); ++t) {
-      const uint32_t* v = &mesh.indices[3 * t];
-      Vec3 p[3] = {toVec3(mesh.positions[v[0]]), toVec3(mesh.positions[v[1]]),
-                   toVec3(mesh.positions[v[2]])};
-      bool candidate = tessellation.borderFaces[mesh.triangleFaces[t]] != 0;
-      if (!candidate) {
-        Vec3 centroid = (p[0] + p[1] + p[2]) * (1.0 / 3.0);
-        bool facing = dot(cross(p[1] - p[0], p[2] - p[0]), camera.viewVector(centroid)) < 0;
-        for (int k = 0; k < 3 && !candidate; ++k) {
-          bool vertexFacing = dot(toVec3(mesh.normals[v[k]]), camera.viewVector(p[k])) < 0;
-          candidate = vertexFacing != facing;
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, mesh.triangleCount(), 4096),
+      [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t t = r.begin(); t < r.end(); ++t) {
+          const uint32_t* v = &mesh.indices[3 * t];
+          Vec3 p[3] = {toVec3(mesh.positions[v[0]]), toVec3(mesh.positions[v[1]]),
+                       toVec3(mesh.positions[v[2]])};
+          bool candidate = tessellation.borderFaces[mesh.triangleFaces[t]] != 0;
+          if (!candidate) {
+            Vec3 centroid = (p[0] + p[1] + p[2]) * (1.0 / 3.0);
+            bool facing = dot(cross(p[1] - p[0], p[2] - p[0]), camera.viewVector(centroid)) < 0;
+            for (int k = 0; k < 3 && !candidate; ++k) {
+              bool vertexFacing = dot(toVec3(mesh.normals[v[k]]), camera.viewVector(p[k])) < 0;
+              candidate = vertexFacing != facing;
+            }
+          }
+          if (!candidate) continue;
+          double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+          for (const Vec3& q : p) {
+            Vec3 s = camera.project(q);
+            x0 = std::min(x0, s.x), y0 = std::min(y0, s.y), x1 = std::max(x1, s.x),
+            y1 = std::max(y1, s.y);
+          }
+          int i0 = std::max(0, static_cast<int>(std::floor(x0))),
+              j0 = std::max(0, static_cast<int>(std::floor(y0)));
+          int i1 = std::min(width - 1, static_cast<int>(std::floor(x1))),
+              j1 = std::min(height - 1, static_cast<int>(std::floor(y1)));
+          for (int j = j0; j <= j1; ++j) {
+            for (int i = i0; i <= i1; ++i) {
+              std::atomic_ref<char>(marked[static_cast<size_t>(j) * width + i])
+                  .store(1, std::memory_order_relaxed);
+            }
+          }
         }
-      }
-      if (!candidate) continue;
-      double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-      for (const Vec3& q : p) {
-        Vec3 s = camera.project(q);
-        x0 = std::min(x0, s.x), y0 = std::min(y0, s.y), x1 = std::max(x1, s.x), y1 = std::max(y1, s.y);
-      }
-      int i0 = std::max(0, static_cast<int>(std::floor(x0))), j0 = std::max(0, static_cast<int>(std::floor(y0)));
-      int i1 = std::min(width - 1, static_cast<int>(std::floor(x1))), j1 = std::min(height - 1, static_cast<int>(std::floor(y1)));
-      for (int j = j0; j <= j1; ++j) {
-        for (int i = i0; i <= i1; ++i) {
-          std::atomic_ref<char>(marked[static_cast<size_t>(j) * width + i]).store(1, std::memory_order_relaxed);
-        }
-      }
-    }
-  });
+      });
   return marked;
 }
 
@@ -131,7 +137,8 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<c
           const float* row = &hint->pixels[static_cast<size_t>(j) * hint->width];
           for (int x = 0; x < width; ++x) {
             uint8_t seen = 0;
-            for (int i = x * s; i < (x + 1) * s; ++i) seen |= row[i] > 0.5f ? kSomeCovered : kSomeUncovered;
+            for (int i = x * s; i < (x + 1) * s; ++i)
+              seen |= row[i] > 0.5f ? kSomeCovered : kSomeUncovered;
             hintBlocks[x] |= seen;
           }
         }
@@ -223,8 +230,8 @@ void castSupersampledMask(const ReferenceTessellation& tessellation, RTCScene sc
   if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
     hint = nullptr;
   }
-  result.refinedPixels = pixelsToRefine(coverage, outlineCandidates(tessellation, camera), width,
-                                        height, hint, s);
+  result.refinedPixels =
+      pixelsToRefine(coverage, outlineCandidates(tessellation, camera), width, height, hint, s);
   size_t refined = 0;
   for (char r : result.refinedPixels) refined += r != 0;
   result.stats.refinedPixels = refined;
@@ -259,10 +266,10 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
     stats.bvhMs = built->bvhMs;
   }
   if (tessellation.ratesScaled < 1) {
-    result.warnings.push_back(
-        "reference: tessellation rates scaled by " + std::to_string(tessellation.ratesScaled) +
-        " to stay within " + std::to_string(static_cast<long>(4 * kReferenceTriangleBudget)) +
-        " triangles; the reference's outline is less exact than usual");
+    result.warnings.push_back("reference: tessellation rates scaled by " +
+                              std::to_string(tessellation.ratesScaled) + " to stay within " +
+                              std::to_string(static_cast<long>(4 * kReferenceTriangleBudget)) +
+                              " triangles; the reference's outline is less exact than usual");
   }
   if (tessellation.outlineErrorPx > kOutlineChordErrorPx * 1.0001) {
     result.warnings.push_back(

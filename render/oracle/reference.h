@@ -26,18 +26,18 @@
 namespace limn::render::oracle {
 
 struct ReferenceStats {
-  size_t triangles = 0;        // of the dense tessellation
+  size_t triangles = 0;  // of the dense tessellation
   size_t raysCast = 0;
-  size_t newtonFailures = 0;   // hits whose refinement did not converge (kept unrefined)
+  size_t newtonFailures = 0;  // hits whose refinement did not converge (kept unrefined)
   double tessellateMs = 0, bvhMs = 0, traceMs = 0;  // 0 for the first two on a cache hit
-  size_t outlineFaces = 0;     // faces tessellated finely because they carry an outline
-  double outlineErrorPx = 0;   // chord error aimed for at the outline, output pixels
-  size_t hits = 0;             // output pixels covered
-  double newtonMs = 0;         // refinement and shading of the hits (traceMs: primary rays only)
-  double maskMs = 0;           // the supersampled mask's rays
-  double outlineMs = 0;        // locating the outline to sub-pixel precision
-  size_t refinedPixels = 0;    // output pixels whose S x S samples were all cast
-  bool sceneCached = false;    // the tessellation and BVH came from the cache
+  size_t outlineFaces = 0;    // faces tessellated finely because they carry an outline
+  double outlineErrorPx = 0;  // chord error aimed for at the outline, output pixels
+  size_t hits = 0;            // output pixels covered
+  double newtonMs = 0;        // refinement and shading of the hits (traceMs: primary rays only)
+  double maskMs = 0;          // the supersampled mask's rays
+  double outlineMs = 0;       // locating the outline to sub-pixel precision
+  size_t refinedPixels = 0;   // output pixels whose S x S samples were all cast
+  bool sceneCached = false;   // the tessellation and BVH came from the cache
 };
 
 struct ReferenceResult {
@@ -55,7 +55,7 @@ struct ReferenceOptions {
   // block is not uniform, or disagrees with the reference's own pixel, get all their samples
   // cast too, so the reference's mask is exact wherever either side has an outline.
   const Image* maskHint = nullptr;
-  bool locateOutline = false;           // needs passes.supersample > 0
+  bool locateOutline = false;            // needs passes.supersample > 0
   ReferenceSceneCache* cache = nullptr;  // where to find and keep the tessellation and BVH
 };
 

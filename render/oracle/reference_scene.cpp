@@ -49,10 +49,12 @@ std::shared_ptr<const ReferenceScene> buildReferenceScene(const subdiv::LimitSur
 
 std::string referenceSceneKey(const mesh::ControlMesh& mesh, const Camera& c) {
   char view[512];
-  std::snprintf(view, sizeof view, "|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g|%d|%.17g|%dx%d|%.17g,%.17g",
-                c.eye().x, c.eye().y, c.eye().z, c.target().x, c.target().y, c.target().z,
-                c.up().x, c.up().y, c.up().z, c.fovYDeg(), static_cast<int>(c.projection()),
-                c.orthoHeight(), c.width(), c.height(), c.nearPlane(), c.farPlane());
+  std::snprintf(
+      view, sizeof view,
+      "|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g|%d|%.17g|%dx%d|%.17g,%.17g",
+      c.eye().x, c.eye().y, c.eye().z, c.target().x, c.target().y, c.target().z, c.up().x, c.up().y,
+      c.up().z, c.fovYDeg(), static_cast<int>(c.projection()), c.orthoHeight(), c.width(),
+      c.height(), c.nearPlane(), c.farPlane());
   return mesh::contentHash(mesh) + view;
 }
 

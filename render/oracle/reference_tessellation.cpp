@@ -21,7 +21,8 @@ std::vector<char> outlineFaces(const subdiv::LimitSurface& surface,
   borderFaces.assign(surface.faceCount(), 0);
   const Far::TopologyLevel& base = surface.baseLevel();
   std::vector<char> outline(surface.faceCount(), 0);
-  for (int f = 0; f < surface.faceCount(); ++f) outline[f] = probes[f].probed && probes[f].silhouette;
+  for (int f = 0; f < surface.faceCount(); ++f)
+    outline[f] = probes[f].probed && probes[f].silhouette;
   for (int e = 0; e < base.GetNumEdges(); ++e) {
     Far::ConstIndexArray faces = base.GetEdgeFaces(e);
     int withLimit = 0;

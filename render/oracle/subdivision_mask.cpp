@@ -80,7 +80,8 @@ std::string unsupportedReason(const subdiv::LimitSurface& surface) {
     }
     if (semiSharp && lo != hi) {
       return "Embree's rule where creases of different sharpness meet differs from "
-             "OpenSubdiv's (vertex " + std::to_string(v) + ")";
+             "OpenSubdiv's (vertex " +
+             std::to_string(v) + ")";
     }
   }
   // Measured on a grid with one lifted interior vertex of valence 2: Embree's surface there is
@@ -153,9 +154,7 @@ void skipHiddenFaces(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-float embreeSharpness(float s) {
-  return s >= mesh::kInfiniteSharpness ? INFINITY : s;
-}
+float embreeSharpness(float s) { return s >= mesh::kInfiniteSharpness ? INFINITY : s; }
 
 // Embree's one tessellation level for all edges (see the caller): enough segments for every edge
 // to keep its chords within kChordErrorPx of the surface (surface_probe.h; 3D lengths, so edges
@@ -182,17 +181,25 @@ float uniformLevel(const subdiv::LimitSurface& surface, const Camera& camera) {
 // Casts eight rays `probe` pixels around pixel (x, y), along the axes and the diagonals; a crack
 // is a line, which passes through at most two opposite probes, so six or more hits make it a
 // crack, and the pixel covered (a hole wider than the probes gets none).
-void closeIfCrack(RTCScene scene, const Camera& camera, RTCIntersectContext& context,
-                  double probe, int x, int y, Image& mask) {
+void closeIfCrack(RTCScene scene, const Camera& camera, RTCIntersectContext& context, double probe,
+                  int x, int y, Image& mask) {
   int hits = 0;
-  for (auto [dx, dy] : {std::pair{-1, -1}, {1, -1}, {-1, 1}, {1, 1}, {-1, 0}, {1, 0}, {0, -1},
-                        {0, 1}}) {
+  for (auto [dx, dy] :
+       {std::pair{-1, -1}, {1, -1}, {-1, 1}, {1, 1}, {-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
     PixelRay r = pixelRay(camera, x + 0.5 + dx * probe, y + 0.5 + dy * probe);
     Vec3 o = r.origin + r.direction * r.tNear;
-    RTCRay ray{static_cast<float>(o.x), static_cast<float>(o.y), static_cast<float>(o.z), 0.0f,
-               static_cast<float>(r.direction.x), static_cast<float>(r.direction.y),
-               static_cast<float>(r.direction.z), 0.0f, static_cast<float>(r.tFar - r.tNear),
-               0xFFFFFFFFu, 0, 0};
+    RTCRay ray{static_cast<float>(o.x),
+               static_cast<float>(o.y),
+               static_cast<float>(o.z),
+               0.0f,
+               static_cast<float>(r.direction.x),
+               static_cast<float>(r.direction.y),
+               static_cast<float>(r.direction.z),
+               0.0f,
+               static_cast<float>(r.tFar - r.tNear),
+               0xFFFFFFFFu,
+               0,
+               0};
     rtcOccluded1(scene, &context, &ray);
     hits += ray.tfar < 0.0f;
   }
@@ -255,10 +262,10 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
   };
   auto* vertices = newBuffer<Float3>(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.points.size());
   auto* faces = newBuffer<unsigned>(g, RTC_BUFFER_TYPE_FACE, RTC_FORMAT_UINT, m.faceCount());
-  auto* indices = newBuffer<unsigned>(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT,
-                                      m.faceVertexIndices.size());
-  auto* levels = newBuffer<float>(g, RTC_BUFFER_TYPE_LEVEL, RTC_FORMAT_FLOAT,
-                                  m.faceVertexIndices.size());
+  auto* indices =
+      newBuffer<unsigned>(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT, m.faceVertexIndices.size());
+  auto* levels =
+      newBuffer<float>(g, RTC_BUFFER_TYPE_LEVEL, RTC_FORMAT_FLOAT, m.faceVertexIndices.size());
   if (!vertices || !faces || !indices || !levels) {
     rtcReleaseGeometry(g);
     return refuse("Embree could not allocate the subdivision mesh: " + takeEmbreeError());
@@ -283,8 +290,8 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
   if (!m.creases.empty()) {
     auto* pairs = newBuffer<unsigned[2]>(g, RTC_BUFFER_TYPE_EDGE_CREASE_INDEX, RTC_FORMAT_UINT2,
                                          m.creases.size());
-    auto* weights = newBuffer<float>(g, RTC_BUFFER_TYPE_EDGE_CREASE_WEIGHT, RTC_FORMAT_FLOAT,
-                                     m.creases.size());
+    auto* weights =
+        newBuffer<float>(g, RTC_BUFFER_TYPE_EDGE_CREASE_WEIGHT, RTC_FORMAT_FLOAT, m.creases.size());
     for (size_t i = 0; pairs && weights && i < m.creases.size(); ++i) {
       pairs[i][0] = static_cast<unsigned>(m.creases[i].v0);
       pairs[i][1] = static_cast<unsigned>(m.creases[i].v1);

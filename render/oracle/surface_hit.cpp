@@ -1,8 +1,8 @@
 #include "render/oracle/surface_hit.h"
 
-#include <cmath>
-
 #include <opensubdiv/bfr/parameterization.h>
+
+#include <cmath>
 
 namespace limn::render::oracle {
 

@@ -25,9 +25,9 @@ struct SurfaceHit {
   bool refined = false;  // Newton converged inside the face
   int face = -1;
   Vec2 uv;
-  double t = 0;          // along the PixelRay
+  double t = 0;  // along the PixelRay
   Vec3 position;
-  Vec3 normal;           // the limit normal at (face, uv): unit, oriented by the face winding
+  Vec3 normal;  // the limit normal at (face, uv): unit, oriented by the face winding
   int iterations = 0;
 };
 

@@ -1,12 +1,11 @@
 #include "render/oracle/surface_probe.h"
 
+#include <opensubdiv/bfr/tessellation.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-
-#include <opensubdiv/bfr/tessellation.h>
 
 namespace limn::render::oracle {
 

@@ -20,10 +20,10 @@
 namespace limn::render::oracle {
 
 struct FaceProbe {
-  bool probed = false;          // false for faces without a limit surface
-  double gMin = 1, gMax = -1;   // range of cos(normal, view direction) over the samples
-  double normalSpread = 0;      // largest |n_i - n_j| between neighbouring samples
-  bool silhouette = false;      // facing changes sign, or nears zero closer than it varies
+  bool probed = false;         // false for faces without a limit surface
+  double gMin = 1, gMax = -1;  // range of cos(normal, view direction) over the samples
+  double normalSpread = 0;     // largest |n_i - n_j| between neighbouring samples
+  bool silhouette = false;     // facing changes sign, or nears zero closer than it varies
   // Per face edge (edge k runs from corner k to corner k + 1): segments needed for a chord error
   // of one pixel; for error e divide by sqrt(e).
   std::vector<double> segmentsAtOnePixel;

@@ -62,8 +62,8 @@ struct VisibilityOptions {
 };
 
 struct VisibilityStats {
-  size_t triangles = 0;        // of the reference tessellation
-  double outlineErrorPx = 0;   // its chord error at outlines
+  size_t triangles = 0;       // of the reference tessellation
+  double outlineErrorPx = 0;  // its chord error at outlines
   size_t raysCast = 0;
   size_t hidden = 0;
   double tessellateMs = 0, bvhMs = 0, traceMs = 0;

@@ -4,8 +4,8 @@
 #include <string>
 
 #include "render/core/error.h"
-#include "render/pipeline/job_checks.h"
 #include "render/oracle/visibility.h"
+#include "render/pipeline/job_checks.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::pipeline {
@@ -29,8 +29,11 @@ ContourResult runContours(const ContourJob& job, const JobLimits& limits,
   cancel.check();
 
   const subdiv::LimitSurface surface(job.mesh, cancel);
-  ContourResult result{.camera = resolveCamera(job.camera, surface.bounds()), .polylines = {},
-                       .stats = {}, .timings = {}, .warnings = {}};
+  ContourResult result{.camera = resolveCamera(job.camera, surface.bounds()),
+                       .polylines = {},
+                       .stats = {},
+                       .timings = {},
+                       .warnings = {}};
   const Camera& camera = result.camera;
   ContourStats& stats = result.stats;
   stats.controlVertices = job.mesh.vertexCount();
@@ -60,8 +63,8 @@ ContourResult runContours(const ContourJob& job, const JobLimits& limits,
     }
   }
   oracle::VisibilityStats seen;
-  std::vector<bool> visible =
-      oracle::contourVisibility(surface, camera, queries, oracle::VisibilityOptions{}, cancel, &seen);
+  std::vector<bool> visible = oracle::contourVisibility(surface, camera, queries,
+                                                        oracle::VisibilityOptions{}, cancel, &seen);
   result.timings.visibilityMs = clock.lapMs();
   result.timings.referenceTessellateMs = seen.tessellateMs;
   result.timings.bvhMs = seen.bvhMs;

@@ -15,8 +15,7 @@ void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& l
     badParameter("params.searchSteps", "must be in 0.." + std::to_string(limits.maxSearchSteps));
   }
   if (curveSamples < 0 || curveSamples > limits.maxCurveSamples) {
-    badParameter("params.curveSamples",
-                 "must be in 0.." + std::to_string(limits.maxCurveSamples));
+    badParameter("params.curveSamples", "must be in 0.." + std::to_string(limits.maxCurveSamples));
   }
 }
 

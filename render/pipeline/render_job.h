@@ -14,8 +14,8 @@
 #include "render/core/image.h"
 #include "render/core/passes.h"
 #include "render/mesh/control_mesh.h"
-#include "render/oracle/reference.h"
 #include "render/metrics/metrics.h"
+#include "render/oracle/reference.h"
 #include "render/silhouette/presubdivide.h"
 #include "render/silhouette/silhouette_mesh.h"
 
@@ -32,18 +32,18 @@ enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette };
 enum class Engine { OpenSubdiv, Masks, Factored };
 
 struct MethodParams {
-  int level = 3;                // uniform
+  int level = 3;                       // uniform
   Engine engine = Engine::OpenSubdiv;  // uniform
-  bool pushToLimit = false;     // uniform: move every refined vertex to its limit position
-  double dicingRate = 1.0;      // adaptive: target edge length in pixels
-  int metricSupersample = 4;    // S for the silhouette metrics
+  bool pushToLimit = false;            // uniform: move every refined vertex to its limit position
+  double dicingRate = 1.0;             // adaptive: target edge length in pixels
+  int metricSupersample = 4;           // S for the silhouette metrics
   // Also ray-cast Embree's own subdivision geometry and report its agreement with the reference
   // (Catmull-Clark only; costs about as much as the reference itself).
   bool referenceCrossCheck = false;
   // silhouette
   silhouette::Presubdivide presubdivide = silhouette::Presubdivide::Auto;
-  int searchSteps = 5;          // bisection steps of the edge search
-  int curveSamples = 32;        // samples per contour curve at most
+  int searchSteps = 5;    // bisection steps of the edge search
+  int curveSamples = 32;  // samples per contour curve at most
   silhouette::CurveMode contour = silhouette::CurveMode::Exact;
 };
 
@@ -93,8 +93,8 @@ struct Stats {
 };
 
 struct Timings {
-  double parseMs = 0, surfaceMs = 0, approxMs = 0, rasterMs = 0, referenceMs = 0,
-         metricsMs = 0, totalMs = 0;
+  double parseMs = 0, surfaceMs = 0, approxMs = 0, rasterMs = 0, referenceMs = 0, metricsMs = 0,
+         totalMs = 0;
   // referenceMs split by stage (when a reference was made); crossCheckMs is part of referenceMs.
   std::optional<oracle::ReferenceStats> reference;
   double crossCheckMs = 0;

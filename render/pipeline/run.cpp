@@ -3,14 +3,14 @@
 #include <string>
 
 #include "render/core/error.h"
-#include "render/pipeline/job_checks.h"
+#include "render/normalmap/mapped_cage.h"
+#include "render/normalmap/normal_atlas.h"
 #include "render/oracle/reference.h"
+#include "render/pipeline/job_checks.h"
 #include "render/pipeline/render_job.h"
 #include "render/pipeline/silhouette_build.h"
 #include "render/raster/rasterizer.h"
 #include "render/rules/refine.h"
-#include "render/normalmap/mapped_cage.h"
-#include "render/normalmap/normal_atlas.h"
 #include "render/silhouette/contour_overlay.h"
 #include "render/subdiv/limit_surface.h"
 #include "render/tessellate/cage_overlay.h"
@@ -24,8 +24,9 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
   const MethodParams& p = job.params;
   if (job.shading == Shading::NormalMap && job.method != Method::Silhouette &&
       job.method != Method::Coarse) {
-    badParameter("shading", "\"normal-map\" is available with methods \"silhouette\" and "
-                            "\"coarse\" (the others draw limit normals per vertex)");
+    badParameter("shading",
+                 "\"normal-map\" is available with methods \"silhouette\" and "
+                 "\"coarse\" (the others draw limit normals per vertex)");
   }
   if (job.method == Method::Uniform && p.engine != Engine::OpenSubdiv) {
     std::string whyNot = rules::unsupportedReason(
@@ -86,9 +87,10 @@ tessellate::TriangleMesh approximate(const RenderJob& job, const JobLimits& limi
     case Method::Uniform: {
       tessellate::UniformOptions options;
       options.level = job.params.level;
-      options.engine = job.params.engine == Engine::Masks      ? tessellate::UniformEngine::Masks
-                       : job.params.engine == Engine::Factored ? tessellate::UniformEngine::Factored
-                                                               : tessellate::UniformEngine::OpenSubdiv;
+      options.engine = job.params.engine == Engine::Masks ? tessellate::UniformEngine::Masks
+                       : job.params.engine == Engine::Factored
+                           ? tessellate::UniformEngine::Factored
+                           : tessellate::UniformEngine::OpenSubdiv;
       options.pushToLimit = job.params.pushToLimit;
       options.maxTriangles = limits.maxTriangles;
       return tessellate::tessellateUniform(surface, options);
@@ -100,7 +102,8 @@ tessellate::TriangleMesh approximate(const RenderJob& job, const JobLimits& limi
       return tessellate::tessellateAdaptive(surface, camera, options, cancel);
     }
     case Method::Limit:
-    case Method::Silhouette: break;  // see runSilhouette
+    case Method::Silhouette:
+      break;  // see runSilhouette
   }
   return {};
 }
@@ -108,8 +111,8 @@ tessellate::TriangleMesh approximate(const RenderJob& job, const JobLimits& limi
 // The silhouette method draws a (possibly pre-subdivided) copy of the mesh: same limit
 // surface, finer cage. `drawn` keeps that surface alive for the caller.
 silhouette::SilhouetteMesh runSilhouette(const RenderJob& job, const JobLimits& limits,
-                                         const subdiv::LimitSurface& surface,
-                                         const Camera& camera, const CancelToken& cancel,
+                                         const subdiv::LimitSurface& surface, const Camera& camera,
+                                         const CancelToken& cancel,
                                          std::unique_ptr<subdiv::LimitSurface>& drawn,
                                          RenderResult& result) {
   const MethodParams& p = job.params;
@@ -152,8 +155,9 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
                          RenderResult& result) {
   const Image& referenceMask = reference.images.supersampledMask;
   if (surface.mesh().scheme != mesh::Scheme::CatmullClark) {
-    result.warnings.push_back("reference cross-check skipped: Embree's subdivision geometry is "
-                              "Catmull-Clark only");
+    result.warnings.push_back(
+        "reference cross-check skipped: Embree's subdivision geometry is "
+        "Catmull-Clark only");
     return;
   }
   std::string whyNot;
@@ -172,9 +176,9 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
   result.stats.referenceCrossCheckOutlinePx = outline.hausdorffPx;
   result.stats.referenceCrossCheckOutlineMeanPx = outline.meanPx;
   if (agreement.hausdorffPx > 1.0) {
-    result.warnings.push_back("the two reference paths disagree: Embree's subdivision geometry is " +
-                              std::to_string(agreement.hausdorffPx) +
-                              " px from the tessellated reference");
+    result.warnings.push_back(
+        "the two reference paths disagree: Embree's subdivision geometry is " +
+        std::to_string(agreement.hausdorffPx) + " px from the tessellated reference");
   }
 }
 
@@ -182,11 +186,16 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
 
 const char* methodName(Method method) {
   switch (method) {
-    case Method::Coarse: return "coarse";
-    case Method::Uniform: return "uniform";
-    case Method::Adaptive: return "adaptive";
-    case Method::Limit: return "limit";
-    case Method::Silhouette: return "silhouette";
+    case Method::Coarse:
+      return "coarse";
+    case Method::Uniform:
+      return "uniform";
+    case Method::Adaptive:
+      return "adaptive";
+    case Method::Limit:
+      return "limit";
+    case Method::Silhouette:
+      return "silhouette";
   }
   return "?";
 }
@@ -200,8 +209,13 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
 
   const subdiv::LimitSurface surface(job.mesh, cancel);
   Camera camera = resolveCamera(job.camera, surface.bounds());
-  RenderResult result{.images = {}, .referenceImages = {}, .metrics = {}, .stats = {},
-                      .timings = {}, .warnings = {}, .camera = camera};
+  RenderResult result{.images = {},
+                      .referenceImages = {},
+                      .metrics = {},
+                      .stats = {},
+                      .timings = {},
+                      .warnings = {},
+                      .camera = camera};
   result.timings.surfaceMs = clock.lapMs();
   result.stats.controlVertices = job.mesh.vertexCount();
   result.stats.controlFaces = job.mesh.faceCount();
@@ -219,8 +233,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     silhouette::SilhouetteMesh built =
         runSilhouette(job, limits, surface, camera, cancel, presubdivided, result);
     if (job.outputs.contours) {
-      overlays.push_back(silhouette::contourOverlay(
-          presubdivided ? *presubdivided : surface, built, pass::kContours));
+      overlays.push_back(silhouette::contourOverlay(presubdivided ? *presubdivided : surface, built,
+                                                    pass::kContours));
     }
     approx = std::move(built.mesh);
     if (job.shading == Shading::NormalMap) {
@@ -252,8 +266,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
 
   // The exact reference and, for Catmull-Clark, its independent cross-check.
   if (needReference) {
-    PassSelection passes{.color = true, .mask = true, .depth = true, .normal = true,
-                         .supersample = measure ? S : 0};
+    PassSelection passes{
+        .color = true, .mask = true, .depth = true, .normal = true, .supersample = measure ? S : 0};
     oracle::ReferenceOptions options{.maskHint = approx ? &result.images.supersampledMask : nullptr,
                                      .locateOutline = measure,
                                      .cache = context.referenceCache};
@@ -274,8 +288,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     if (measure) {
       const ImageSet& approxImages = result.images;
       const ImageSet& refImages = reference.images;
-      result.metrics.silhouette = metrics::compareSilhouettes(
-          approxImages.supersampledMask, refImages.supersampledMask, S);
+      result.metrics.silhouette =
+          metrics::compareSilhouettes(approxImages.supersampledMask, refImages.supersampledMask, S);
       // The reference was hinted with this mask: its refined pixels hold all of its outline.
       metrics::Outline outline = oracle::locateMeshOutline(
           *approx, camera, approxImages.supersampledMask, S, cancel, &reference.refinedPixels);
@@ -292,7 +306,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       result.images = selectOutputs(reference.images, job.outputs, true);
       result.stats.triangles = reference.stats.triangles;
     }
-    if (job.reference) result.referenceImages = selectOutputs(std::move(reference.images), job.outputs, true);
+    if (job.reference)
+      result.referenceImages = selectOutputs(std::move(reference.images), job.outputs, true);
   }
   if (approx && job.reference) {
     // Silhouette meshes live on the pre-subdivided copy: the same limit surface, finer faces.
@@ -301,7 +316,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   }
   result.timings.metricsMs = clock.lapMs();
 
-  if (job.method != Method::Limit) result.images = selectOutputs(std::move(result.images), job.outputs, false);
+  if (job.method != Method::Limit)
+    result.images = selectOutputs(std::move(result.images), job.outputs, false);
   result.timings.totalMs = total.lapMs();
   return result;
 }

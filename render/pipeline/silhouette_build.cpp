@@ -32,7 +32,8 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
         throw InputError(InputError::Kind::InvalidMesh, "presubdivide",
                          std::string("the silhouette method must refine this mesh once (it has "
                                      "faces other than quads or triangles), and the refined "
-                                     "mesh cannot be evaluated: ") + e.what());
+                                     "mesh cannot be evaluated: ") +
+                             e.what());
       }
       warnings.push_back(std::string("pre-subdivision skipped: ") + e.what());
     }

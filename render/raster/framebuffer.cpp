@@ -43,8 +43,8 @@ void Framebuffer::allocate(int width, int height) {
     glNamedFramebufferRenderbuffer(framebuffer_, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
                                    depthBuffer_);
   }
-  const std::string what = "allocating a " + std::to_string(width) + " x " +
-                           std::to_string(height) + " framebuffer";
+  const std::string what =
+      "allocating a " + std::to_string(width) + " x " + std::to_string(height) + " framebuffer";
   checkGl(what.c_str());
   checkFramebuffer(framebuffer_, what.c_str());
   width_ = width;
@@ -62,8 +62,7 @@ void Framebuffer::setDrawBuffers(const std::vector<bool>& enabled) {
   for (size_t i = 0; i < enabled.size(); ++i) {
     buffers.push_back(enabled[i] ? GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i) : GL_NONE);
   }
-  glNamedFramebufferDrawBuffers(framebuffer_, static_cast<GLsizei>(buffers.size()),
-                                buffers.data());
+  glNamedFramebufferDrawBuffers(framebuffer_, static_cast<GLsizei>(buffers.size()), buffers.data());
 }
 
 void Framebuffer::clearColor(int attachment, const float value[4]) {
@@ -78,7 +77,8 @@ void Framebuffer::clearDepth(float value) {
 void Framebuffer::read(int attachment, GLenum format, std::vector<float>& out) const {
   const size_t components = format == GL_RGBA ? 4 : 1;
   out.resize(static_cast<size_t>(width_) * height_ * components);
-  glNamedFramebufferReadBuffer(framebuffer_, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
+  glNamedFramebufferReadBuffer(framebuffer_,
+                               GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
   glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadnPixels(0, 0, width_, height_, format, GL_FLOAT,
@@ -89,7 +89,8 @@ void Framebuffer::read(int attachment, GLenum format, std::vector<float>& out) c
 void Framebuffer::readBytes(int attachment, GLenum format, std::vector<unsigned char>& out) const {
   const size_t components = format == GL_RGBA ? 4 : 1;
   out.resize(static_cast<size_t>(width_) * height_ * components);
-  glNamedFramebufferReadBuffer(framebuffer_, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
+  glNamedFramebufferReadBuffer(framebuffer_,
+                               GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
   glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadnPixels(0, 0, width_, height_, format, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()),

@@ -90,8 +90,8 @@ void MeshBuffers::upload(const tessellate::TriangleMesh& mesh, bool withTexcoord
   checkIndices(mesh.indices, 3, vertexCount, "triangle");
   checkIndices(mesh.lines, 2, vertexCount, "line");
   if (!mesh.normals.empty() && mesh.normals.size() != vertexCount) {
-    throw std::invalid_argument("raster: " + std::to_string(mesh.normals.size()) +
-                                " normals for " + std::to_string(vertexCount) + " vertices");
+    throw std::invalid_argument("raster: " + std::to_string(mesh.normals.size()) + " normals for " +
+                                std::to_string(vertexCount) + " vertices");
   }
   if (!mesh.texcoords.empty() && mesh.texcoords.size() != vertexCount) {
     throw std::invalid_argument("raster: " + std::to_string(mesh.texcoords.size()) +

@@ -103,8 +103,7 @@ struct Rasterizer::Impl {
   DeviceInfo device;
   ShaderProgram surfaceProgram{"surface", surfaceVertexShader(), surfaceFragmentShader()};
   ShaderProgram solidProgram{"solid", solidVertexShader(), solidFragmentShader()};
-  ShaderProgram lineProgram{"line", lineVertexShader(), lineFragmentShader(),
-                            lineGeometryShader()};
+  ShaderProgram lineProgram{"line", lineVertexShader(), lineFragmentShader(), lineGeometryShader()};
   MeshBuffers mesh;
   NormalTexture normalTexture;
   OverlayBuffers overlayLines;

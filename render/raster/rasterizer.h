@@ -39,9 +39,9 @@
 namespace limn::render::raster {
 
 struct DeviceInfo {
-  std::string renderer;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
-  std::string vendor;    // GL_VENDOR
-  std::string version;   // GL_VERSION
+  std::string renderer;     // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string vendor;       // GL_VENDOR
+  std::string version;      // GL_VERSION
   std::string eglPlatform;  // "device" or "surfaceless"
   int maxTextureSize = 0;   // GL_MAX_TEXTURE_SIZE: the largest normal map side it can take
 };

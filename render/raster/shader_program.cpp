@@ -42,8 +42,7 @@ GLuint compile(GLenum stage, const std::string& source, const std::string& what)
 }  // namespace
 
 ShaderProgram::ShaderProgram(const std::string& name, const std::string& vertexSource,
-                             const std::string& fragmentSource,
-                             const std::string& geometrySource) {
+                             const std::string& fragmentSource, const std::string& geometrySource) {
   struct Stage {
     GLenum type;
     const std::string* source;

@@ -1,6 +1,6 @@
-// ShaderProgram: a linked GLSL program (vertex, optional geometry, fragment) owned by one context. Compile and
-// link errors become std::runtime_error with the driver's log. Uniforms are set through the
-// direct-state-access calls, so the program need not be bound to be configured.
+// ShaderProgram: a linked GLSL program (vertex, optional geometry, fragment) owned by one context.
+// Compile and link errors become std::runtime_error with the driver's log. Uniforms are set through
+// the direct-state-access calls, so the program need not be bound to be configured.
 #pragma once
 
 #include <array>

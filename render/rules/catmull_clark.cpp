@@ -33,12 +33,14 @@ Vec3 maskPoint(Rule rule, const Topology& t, const std::vector<Vec3>& P, int v, 
                bool child) {
   switch (rule) {
     case Rule::Smooth:
-    case Rule::Dart: return smooth;
+    case Rule::Dart:
+      return smooth;
     case Rule::Crease:
       return creasePoint(t, P, v, [&](int e) {
         return isSharp(child ? childEdgeSharpness(t, e, v) : t.edgeSharpness[e]);
       });
-    case Rule::Corner: break;
+    case Rule::Corner:
+      break;
   }
   return P[v];
 }

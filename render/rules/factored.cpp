@@ -66,8 +66,11 @@ std::vector<Vec3> factoredPoints(const Topology& t, const Topology& child,
   for (int v = 0; v < V; ++v) {
     switch (currentRule(t, v)) {
       case Rule::Smooth:
-      case Rule::Dart: break;
-      case Rule::Corner: out[v] = P[v]; break;
+      case Rule::Dart:
+        break;
+      case Rule::Corner:
+        out[v] = P[v];
+        break;
       case Rule::Crease: {
         // Average the vertex with its two crease midpoints, twice: (m_a + 2 v + m_b) / 4.
         Vec3 curve = 0.5 * P[v];

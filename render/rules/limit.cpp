@@ -102,10 +102,16 @@ class LimitMasks {
         }
       }
       switch (currentRule(t_, v)) {
-        case Rule::Corner: tangents = cornerSides(v); break;
-        case Rule::Crease: tangents = creaseSides(v, position); break;
+        case Rule::Corner:
+          tangents = cornerSides(v);
+          break;
+        case Rule::Crease:
+          tangents = creaseSides(v, position);
+          break;
         case Rule::Smooth:
-        case Rule::Dart: tangents = smooth(v, position); break;
+        case Rule::Dart:
+          tangents = smooth(v, position);
+          break;
       }
     }
     out.positions[v] = position;
@@ -175,7 +181,8 @@ class LimitMasks {
       if (n == 2) return cornerSides(v);  // OpenSubdiv's choice at an interior valence 2
       for (int i = 0; i < n; ++i) faceSum += F_[i];
       position = catmullClarkLimitVertexWeight(n) * P_[v] +
-                 catmullClarkLimitEdgeWeight(n) * edgeSum + catmullClarkLimitFaceWeight(n) * faceSum;
+                 catmullClarkLimitEdgeWeight(n) * edgeSum +
+                 catmullClarkLimitFaceWeight(n) * faceSum;
       // Edge weights 4 cos(i theta), face weights (cos(i theta) + cos((i+1) theta)) /
       // (4 lambda - 1), lambda the subdominant eigenvalue; the second tangent is the first
       // rotated by one edge.
@@ -242,8 +249,8 @@ Limit limitOf(const Level& level) {
       for (int k = 0; k < t.faceSize(f); ++k) {
         const int q = t.faceOffsets[f] + k;  // the child quad at corner k
         const int v = t.faceVerts(f)[k];
-        out.cornerNormals[q] = fine.cornerNormals[child.topology.faceOffsets[q] +
-                                                  child.topology.cornerOf(q, v)];
+        out.cornerNormals[q] =
+            fine.cornerNormals[child.topology.faceOffsets[q] + child.topology.cornerOf(q, v)];
       }
     }
     return out;

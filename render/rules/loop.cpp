@@ -28,9 +28,12 @@ Vec3 maskPoint(Rule rule, const Topology& t, const std::vector<Vec3>& P, int v, 
                bool child) {
   switch (rule) {
     case Rule::Smooth:
-    case Rule::Dart: return smooth;
-    case Rule::Crease: return creasePoint(t, P, v, child);
-    case Rule::Corner: break;
+    case Rule::Dart:
+      return smooth;
+    case Rule::Crease:
+      return creasePoint(t, P, v, child);
+    case Rule::Corner:
+      break;
   }
   return P[v];
 }
@@ -66,8 +69,8 @@ std::vector<Vec3> loopPoints(const Topology& t, const std::vector<Vec3>& P) {
       vw = w * 0.5 + (1.0 - w) * vw;
       fw *= 1.0 - w;
     }
-    edgePoint[e] = vw * (P[a] + P[b]) +
-                   fw * (P[opposite(t, faces[0], e)] + P[opposite(t, faces[1], e)]);
+    edgePoint[e] =
+        vw * (P[a] + P[b]) + fw * (P[opposite(t, faces[0], e)] + P[opposite(t, faces[1], e)]);
   }
 
   const VertexRules rules = vertexRules(t);

@@ -47,8 +47,8 @@ std::string unsupportedReason(const mesh::ControlMesh& m, Method method) {
   bool semiSharp = false;
   for (const mesh::Crease& c : m.creases) semiSharp = semiSharp || isSemiSharp(c.sharpness);
   for (const mesh::Corner& c : m.corners) semiSharp = semiSharp || isSemiSharp(c.sharpness);
-  bool smoothTriangles = m.triangleSubdivision == mesh::TriangleSubdivision::Smooth &&
-                         hasTriangle(m.faceVertexCounts);
+  bool smoothTriangles =
+      m.triangleSubdivision == mesh::TriangleSubdivision::Smooth && hasTriangle(m.faceVertexCounts);
   return reasonFor(m.scheme, method, semiSharp, smoothTriangles);
 }
 

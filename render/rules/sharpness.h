@@ -33,10 +33,14 @@ inline float decaySharpness(float s) {
 inline Rule ruleOf(float vertexSharpness, int sharpEdges) {
   if (isSharp(vertexSharpness)) return Rule::Corner;
   switch (sharpEdges) {
-    case 0: return Rule::Smooth;
-    case 1: return Rule::Dart;
-    case 2: return Rule::Crease;
-    default: return Rule::Corner;
+    case 0:
+      return Rule::Smooth;
+    case 1:
+      return Rule::Dart;
+    case 2:
+      return Rule::Crease;
+    default:
+      return Rule::Corner;
   }
 }
 

@@ -24,7 +24,8 @@ void inheritTags(const Topology& p, int firstHalf, Topology& c) {
     }
   }
   c.vertexSharpness.assign(c.vertexCount, 0.0f);
-  for (int v = 0; v < p.vertexCount; ++v) c.vertexSharpness[v] = decaySharpness(p.vertexSharpness[v]);
+  for (int v = 0; v < p.vertexCount; ++v)
+    c.vertexSharpness[v] = decaySharpness(p.vertexSharpness[v]);
 }
 
 // The child of parent face f at its corner k.
@@ -45,7 +46,8 @@ void orderLikeFar(const Topology& p, int firstHalf, ChildFace child, int firstEd
     for (int end = 0; end < 2; ++end) {
       const int v = p.edgeVertices[e][end], half = firstHalf + 2 * e + end;
       for (size_t i = 0; i < parentFaces.size(); ++i) {
-        c.edgeFaces[c.edgeFaceOffsets[half] + i] = child(p, parentFaces[i], p.cornerOf(parentFaces[i], v));
+        c.edgeFaces[c.edgeFaceOffsets[half] + i] =
+            child(p, parentFaces[i], p.cornerOf(parentFaces[i], v));
       }
     }
   }
@@ -65,7 +67,7 @@ void orderLikeFar(const Topology& p, int firstHalf, ChildFace child, int firstEd
     const int f = faces[0], n = p.faceSize(f);
     const int k = p.cornerOf(f, p.edgeVertices[e][0]);
     const int end = p.faceVerts(f)[(k + 1) % n] == p.edgeVertices[e][1] ? p.edgeVertices[e][1]
-                                                                          : p.edgeVertices[e][0];
+                                                                        : p.edgeVertices[e][0];
     c.ringStart[firstEdgeChild + e] = child(p, f, p.cornerOf(f, end));
   }
 }

@@ -18,7 +18,8 @@ uint64_t edgeKey(int a, int b) {
 [[noreturn]] void notManifold(const std::string& subject, const std::string& what) {
   throw InputError(InputError::Kind::InvalidMesh, subject,
                    "limn's own subdivision rules take manifold, consistently oriented meshes "
-                   "only: " + what);
+                   "only: " +
+                       what);
 }
 
 std::string edgeName(const Topology& t, int e) {
@@ -44,8 +45,8 @@ void checkManifold(const Topology& t) {
     for (size_t i = 0; i < fv.size(); ++i) {
       for (size_t j = i + 1; j < fv.size(); ++j) {
         if (fv[i] == fv[j]) {
-          notManifold("face " + std::to_string(f), "face " + std::to_string(f) +
-                                                        " repeats vertex " + std::to_string(fv[i]));
+          notManifold("face " + std::to_string(f),
+                      "face " + std::to_string(f) + " repeats vertex " + std::to_string(fv[i]));
         }
       }
     }

@@ -87,8 +87,8 @@ ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const C
       Far::ConstIndexArray ends = base.GetEdgeVertices(static_cast<int>(e));
       Vec2 uv = edgeUV(surface, owner, static_cast<int>(e), 0.5);
       subdiv::LimitSample mid = surface.evaluate(owner, uv.x, uv.y);
-      int segments = segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), mid),
-                                 options);
+      int segments =
+          segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), mid), options);
       if (segments < 2) continue;
       out.edgeRates[e] = segments;
       for (int i = 1; i < segments; ++i) {

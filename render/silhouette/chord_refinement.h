@@ -3,8 +3,8 @@
 // the chord lies OUTSIDE it, and next to the contour such a chord either pokes past the exact
 // outline (into a torus's hole, say) or hides part of it. The correction is propagated two
 // rings out from the contour faces: every edge of a contour face or of a face near one (see
-// ChordOptions::rings) whose chord lies outside the surface by more than `tolerancePx` (projected) gets
-// uniform points along its limit curve, enough to bring the chord's sag under the tolerance
+// ChordOptions::rings) whose chord lies outside the surface by more than `tolerancePx` (projected)
+// gets uniform points along its limit curve, enough to bring the chord's sag under the tolerance
 // (sag falls with the square of the segment count); such ring faces whose centre lies outside
 // the surface likewise get interior points. Chords inside the surface (convex regions) stay:
 // the exact contour curves already bound the outline there.

@@ -11,8 +11,7 @@ namespace {
 
 // An edge point's identity: (base edge, index into that edge's points).
 uint64_t key(int edge, int point) {
-  return (static_cast<uint64_t>(static_cast<uint32_t>(edge)) << 32) |
-         static_cast<uint32_t>(point);
+  return (static_cast<uint64_t>(static_cast<uint32_t>(edge)) << 32) | static_cast<uint32_t>(point);
 }
 uint64_t fromKey(const ContourCurve& c) { return key(c.fromEdge, c.fromPoint); }
 uint64_t toKey(const ContourCurve& c) { return key(c.toEdge, c.toPoint); }

@@ -22,11 +22,11 @@
 namespace limn::render::silhouette {
 
 struct PolylinePoint {
-  Vec3 position;     // 3D, on the limit surface ("exact" curves and edge points)
-  Vec3 normal;       // the limit normal there: perpendicular to the view on the contour
-  Vec3 pixel;        // Camera::project: x right, y down (pixels), z = linear depth
-  int face = -1;     // face of the surface the curves were found on (after pre-subdivision)
-  Vec2 uv;           // in that face's parameterisation
+  Vec3 position;           // 3D, on the limit surface ("exact" curves and edge points)
+  Vec3 normal;             // the limit normal there: perpendicular to the view on the contour
+  Vec3 pixel;              // Camera::project: x right, y down (pixels), z = linear depth
+  int face = -1;           // face of the surface the curves were found on (after pre-subdivision)
+  Vec2 uv;                 // in that face's parameterisation
   bool edgePoint = false;  // on a control edge: a junction of two curves, or an open end
 };
 

@@ -45,12 +45,15 @@ EdgeInFace locateEdge(const Far::TopologyLevel& base, int face, int edge) {
 class EdgeProbe {
  public:
   EdgeProbe(const subdiv::LimitSurface& surface, const Camera& camera, int face, int edge)
-      : surface_(surface), camera_(camera), face_(face),
-        from_(edgeUV(surface, face, edge, 0.0)), to_(edgeUV(surface, face, edge, 1.0)) {}
+      : surface_(surface),
+        camera_(camera),
+        face_(face),
+        from_(edgeUV(surface, face, edge, 0.0)),
+        to_(edgeUV(surface, face, edge, 1.0)) {}
 
   double g(double t) const {
-    subdiv::LimitSample s = surface_.evaluate(face_, from_.x + (to_.x - from_.x) * t,
-                                              from_.y + (to_.y - from_.y) * t);
+    subdiv::LimitSample s =
+        surface_.evaluate(face_, from_.x + (to_.x - from_.x) * t, from_.y + (to_.y - from_.y) * t);
     return contourFunction(camera_, s.position, s.normal);
   }
   double slope(double t) const {
@@ -67,8 +70,7 @@ class EdgeProbe {
 };
 
 // Narrows a sign change of g in [a, b] by bisection, then interpolates linearly.
-double findCrossing(const EdgeProbe& probe, double a, double ga, double b, double gb,
-                    int steps) {
+double findCrossing(const EdgeProbe& probe, double a, double ga, double b, double gb, int steps) {
   for (int i = 0; i < steps; ++i) {
     double m = 0.5 * (a + b);
     double gm = probe.g(m);
@@ -156,7 +158,8 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
       if (validFaces == 0) continue;
       ++tested;
       const bool split = validFaces > 2 ||
-          (validFaces == 2 && base.GetEdgeSharpness(static_cast<int>(e)) >= mesh::kInfiniteSharpness);
+                         (validFaces == 2 &&
+                          base.GetEdgeSharpness(static_cast<int>(e)) >= mesh::kInfiniteSharpness);
 
       found.clear();
       bool signChange = false, wasSampled = false, sideSignsDiffer = false;
@@ -199,8 +202,8 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
           for (int i = 0; i < intervals; ++i) {
             double a = ts[i], b = ts[i + 1];
             if (signOf(gs[i]) != signOf(gs[i + 1])) {
-              found.push_back({findCrossing(probe, a, gs[i], b, gs[i + 1], options.searchSteps),
-                               {}, bits});
+              found.push_back(
+                  {findCrossing(probe, a, gs[i], b, gs[i + 1], options.searchSteps), {}, bits});
               continue;
             }
             // Same sign at both ends: look for an extremum that reaches the other sign.
@@ -214,7 +217,8 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
             double tm = 0.5 * (lo + hi), gm = probe.g(tm);
             if (signOf(gm) == sign) continue;
             found.push_back({findCrossing(probe, a, gs[i], tm, gm, options.searchSteps), {}, bits});
-            found.push_back({findCrossing(probe, tm, gm, b, gs[i + 1], options.searchSteps), {}, bits});
+            found.push_back(
+                {findCrossing(probe, tm, gm, b, gs[i + 1], options.searchSteps), {}, bits});
           }
         }
         if (signOf(g0) == signOf(g1) && found.size() > foundBefore) ++doubles;
@@ -227,8 +231,8 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
         const Vec3 a = camera.project(limitPositions[ends[0]]);
         const Vec3 b = camera.project(limitPositions[ends[1]]);
         double pixels = std::hypot(a.x - b.x, a.y - b.y);
-        int segments = std::clamp(static_cast<int>(std::ceil(pixels / options.pixelsPerSample)),
-                                  1, std::max(1, options.outlineSamples + 1));
+        int segments = std::clamp(static_cast<int>(std::ceil(pixels / options.pixelsPerSample)), 1,
+                                  std::max(1, options.outlineSamples + 1));
         for (int i = 1; i < segments; ++i) {
           found.push_back({static_cast<double>(i) / segments, {}, 0u});
         }

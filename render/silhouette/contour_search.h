@@ -44,19 +44,19 @@ struct SearchOptions {
 // A point on the limit curve of a base edge where g changes sign for at least one of the
 // edge's faces.
 struct EdgePoint {
-  double t = 0;       // edge parameter: 0 at the edge's first vertex, 1 at its second
-  Vec3 position;      // on the limit curve, evaluated once so every face uses the same bits
-  uint32_t sides = 0; // bit k: a crossing of g as seen from the edge's k-th face (0: a point
-                      // that only shapes an outline edge)
+  double t = 0;        // edge parameter: 0 at the edge's first vertex, 1 at its second
+  Vec3 position;       // on the limit curve, evaluated once so every face uses the same bits
+  uint32_t sides = 0;  // bit k: a crossing of g as seen from the edge's k-th face (0: a point
+                       // that only shapes an outline edge)
 };
 
 struct SearchStats {
-  size_t edgesTested = 0;        // edges with a face that has a limit surface
+  size_t edgesTested = 0;          // edges with a face that has a limit surface
   size_t edgesWithSignChange = 0;  // ends of different sign (for some face)
-  size_t edgesSampled = 0;       // searched inside because the bound could not clear them
-  size_t doubleCrossings = 0;    // edges with ends of the same sign and crossings inside
-  size_t outlineEdges = 0;       // boundary or sharp edges drawn along their limit curve
-  size_t contourPoints = 0;      // distinct edge points
+  size_t edgesSampled = 0;         // searched inside because the bound could not clear them
+  size_t doubleCrossings = 0;      // edges with ends of the same sign and crossings inside
+  size_t outlineEdges = 0;         // boundary or sharp edges drawn along their limit curve
+  size_t contourPoints = 0;        // distinct edge points
 };
 
 struct ContourSearch {
@@ -64,7 +64,7 @@ struct ContourSearch {
   // a smooth vertex share one value; corners at sharp features keep their face's own.
   std::vector<double> cornerG;
   std::vector<Vec3> cornerNormals;
-  std::vector<size_t> faceOffsets;        // start of each face's corners in the arrays above
+  std::vector<size_t> faceOffsets;  // start of each face's corners in the arrays above
   std::vector<std::vector<EdgePoint>> edgePoints;  // per base edge, sorted by t
   SearchStats stats;
 };

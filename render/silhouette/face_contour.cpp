@@ -1,9 +1,9 @@
 #include "render/silhouette/face_contour.h"
 
+#include <opensubdiv/bfr/parameterization.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <opensubdiv/bfr/parameterization.h>
 
 namespace limn::render::silhouette {
 
@@ -22,7 +22,9 @@ Vec2 lerp(const Vec2& a, const Vec2& b, double s) {
 class CrossLineSolver {
  public:
   CrossLineSolver(const subdiv::LimitSurface& surface, const Camera& camera, int face)
-      : surface_(surface), camera_(camera), face_(face),
+      : surface_(surface),
+        camera_(camera),
+        face_(face),
         triangle_(surface.parameterization(face).GetType() == Bfr::Parameterization::TRI) {}
 
   bool inside(const Vec2& uv) const {
@@ -111,8 +113,7 @@ class CrossLineSolver {
 
 // Samples strictly between boundary points a and b.
 FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
-                      const FaceBoundary& boundary, int from, int to,
-                      const CurveOptions& options) {
+                      const FaceBoundary& boundary, int from, int to, const CurveOptions& options) {
   FaceCurve curve;
   curve.from = from;
   curve.to = to;
@@ -138,8 +139,8 @@ FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
     Vec3 b2 = (2.0 * b.position + a.position + dot(d, b.normal) * b.normal) / 3.0;
     for (int i = 1; i <= count; ++i) {
       double s = static_cast<double>(i) / (count + 1), r = 1 - s;
-      Vec3 p = r * r * r * a.position + 3 * r * r * s * b1 + 3 * r * s * s * b2 +
-               s * s * s * b.position;
+      Vec3 p =
+          r * r * r * a.position + 3 * r * r * s * b1 + 3 * r * s * s * b2 + s * s * s * b.position;
       Vec2 uv = lerp(a.uv, b.uv, s);
       uv = {uv.x + 4 * s * r * bow.x, uv.y + 4 * s * r * bow.y};
       curve.samples.push_back({uv, p, normalize(r * a.normal + s * b.normal)});

@@ -37,7 +37,7 @@ struct FaceBoundary {
   int face = -1;
   std::vector<FacePoint> points;
   std::vector<bool> crossing;
-  std::vector<int> edge;    // base edge holding each edge point (-1 for corners)
+  std::vector<int> edge;       // base edge holding each edge point (-1 for corners)
   std::vector<int> edgePoint;  // index into ContourSearch::edgePoints[edge], -1 for corners
   int edgePointCount = 0;
 };
@@ -50,7 +50,7 @@ struct FaceCurve {
 
 struct CurveOptions {
   CurveMode mode = CurveMode::Exact;
-  int curveSamples = 32;    // at most this many samples between two crossings
+  int curveSamples = 32;  // at most this many samples between two crossings
   double pixelsPerSample = 2.0;
 };
 

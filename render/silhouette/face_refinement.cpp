@@ -32,8 +32,8 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
                         int boundaryCount, const std::vector<std::vector<int>>& lockedChains,
                         double tolerancePx, int maxSplits, std::vector<FacePoint>& points,
                         std::vector<std::array<int, 3>>& triangles) {
-  const bool triangle = surface.parameterization(face).GetType() ==
-                        OpenSubdiv::Bfr::Parameterization::TRI;
+  const bool triangle =
+      surface.parameterization(face).GetType() == OpenSubdiv::Bfr::Parameterization::TRI;
   std::set<Edge> locked;
   for (int i = 0; i < boundaryCount; ++i) locked.insert(key(i, (i + 1) % boundaryCount));
   for (const std::vector<int>& chain : lockedChains) {
@@ -141,8 +141,7 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
   };
   double areaAfter = 0;
   if (splits > 0 && tiledBefore &&
-      (!tiling(&areaAfter) || std::fabs(areaAfter - areaBefore) > 1e-9 * areaBefore ||
-       folded())) {
+      (!tiling(&areaAfter) || std::fabs(areaAfter - areaBefore) > 1e-9 * areaBefore || folded())) {
     triangles = original;
     points.resize(originalPoints);
     return 0;

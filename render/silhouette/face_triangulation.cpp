@@ -53,7 +53,8 @@ void earClip(const std::vector<Vec2>& uv, std::vector<int> polygon,
       size_t best = 0;
       double bestArea = -1e300;
       for (size_t i = 0; i < n; ++i) {
-        double area = cross2(uv[polygon[(i + n - 1) % n]], uv[polygon[i]], uv[polygon[(i + 1) % n]]);
+        double area =
+            cross2(uv[polygon[(i + n - 1) % n]], uv[polygon[i]], uv[polygon[(i + 1) % n]]);
         if (area > bestArea) {
           bestArea = area;
           best = i;
@@ -84,8 +85,8 @@ std::vector<std::array<int, 3>> triangulateFace(const std::vector<Vec2>& uv, int
       if (ia == region.end() || ib == region.end()) continue;
       // Rotate so the region starts at `from`: [from, ..., to, ...].
       std::rotate(region.begin(), ia, region.end());
-      size_t toAt = static_cast<size_t>(std::find(region.begin(), region.end(), curve.to) -
-                                        region.begin());
+      size_t toAt =
+          static_cast<size_t>(std::find(region.begin(), region.end(), curve.to) - region.begin());
       // First part: from -> (boundary) -> to -> (curve backwards) -> from.
       std::vector<int> first(region.begin(), region.begin() + static_cast<long>(toAt) + 1);
       first.insert(first.end(), curve.interior.rbegin(), curve.interior.rend());

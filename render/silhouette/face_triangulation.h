@@ -13,8 +13,8 @@
 namespace limn::render::silhouette {
 
 struct CurvePath {
-  int from = -1, to = -1;         // boundary point indices
-  std::vector<int> interior;      // point indices of its samples, in order from `from`
+  int from = -1, to = -1;     // boundary point indices
+  std::vector<int> interior;  // point indices of its samples, in order from `from`
 };
 
 // Points 0 .. boundaryCount-1 form the boundary, counter-clockwise in uv; the curves join

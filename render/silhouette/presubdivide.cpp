@@ -1,9 +1,9 @@
 #include "render/silhouette/presubdivide.h"
 
-#include <memory>
-
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyRefiner.h>
+
+#include <memory>
 
 #include "render/subdiv/limit_surface.h"
 

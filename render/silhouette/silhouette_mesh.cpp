@@ -1,5 +1,7 @@
 #include "render/silhouette/silhouette_mesh.h"
 
+#include <opensubdiv/bfr/tessellation.h>
+
 #include <string>
 
 #include "render/core/error.h"
@@ -7,8 +9,6 @@
 #include "render/silhouette/chord_refinement.h"
 #include "render/silhouette/face_refinement.h"
 #include "render/silhouette/face_triangulation.h"
-
-#include <opensubdiv/bfr/tessellation.h>
 
 namespace limn::render::silhouette {
 
@@ -119,10 +119,9 @@ FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
       chain.push_back(path.to);
       chains.push_back(std::move(chain));
     }
-    piece.splits = refineFaceTriangles(surface, camera, face,
-                                       static_cast<int>(boundary.points.size()), chains,
-                                       options.chords.tolerancePx, options.chords.maxFaceSplits,
-                                       piece.points, piece.triangles);
+    piece.splits = refineFaceTriangles(
+        surface, camera, face, static_cast<int>(boundary.points.size()), chains,
+        options.chords.tolerancePx, options.chords.maxFaceSplits, piece.points, piece.triangles);
   }
   return piece;
 }
@@ -134,9 +133,8 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
   SilhouetteMesh out;
   out.search = searchContour(surface, camera, options.search, cancel);
   out.stats.search = out.search.stats;
-  const ChordRefinement chords =
-      refineConcaveChords(surface, camera, contourFaces(surface, out.search), options.chords,
-                          out.search);
+  const ChordRefinement chords = refineConcaveChords(
+      surface, camera, contourFaces(surface, out.search), options.chords, out.search);
   out.stats.refinedEdges = chords.refinedEdges;
   out.stats.refinedFaces = chords.refinedFaces;
 

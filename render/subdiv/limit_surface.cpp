@@ -1,14 +1,14 @@
 #include "render/subdiv/limit_surface.h"
 
-#include <algorithm>
-#include <cstdio>
-#include <mutex>
-#include <string>
-
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
 #include <opensubdiv/far/error.h>
 #include <opensubdiv/far/topologyDescriptor.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <mutex>
+#include <string>
 
 #include "render/core/error.h"
 #include "render/subdiv/far_patch_surface.h"
@@ -43,9 +43,12 @@ void installFarErrorCallback() {
 
 Sdc::SchemeType schemeType(mesh::Scheme scheme) {
   switch (scheme) {
-    case mesh::Scheme::Loop: return Sdc::SCHEME_LOOP;
-    case mesh::Scheme::Bilinear: return Sdc::SCHEME_BILINEAR;
-    case mesh::Scheme::CatmullClark: break;
+    case mesh::Scheme::Loop:
+      return Sdc::SCHEME_LOOP;
+    case mesh::Scheme::Bilinear:
+      return Sdc::SCHEME_BILINEAR;
+    case mesh::Scheme::CatmullClark:
+      break;
   }
   return Sdc::SCHEME_CATMARK;
 }

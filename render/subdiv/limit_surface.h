@@ -15,11 +15,11 @@
 // every reference made from this surface agrees.
 #pragma once
 
-#include <memory>
-#include <vector>
-
 #include <opensubdiv/bfr/parameterization.h>
 #include <opensubdiv/far/topologyRefiner.h>
+
+#include <memory>
+#include <vector>
 
 #include "render/core/cancel.h"
 #include "render/core/vec.h"
@@ -95,8 +95,7 @@ class LimitSurface {
   void build(const std::vector<int>& alsoOnFarPatches, const CancelToken& cancel);
   void buildFaceSurfaces(const std::vector<int>& farPatchFaces, const CancelToken& cancel);
   void computeControlLimits(const CancelToken& cancel);
-  void evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du,
-                           Vec3& dv) const;
+  void evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du, Vec3& dv) const;
 
   mesh::ControlMesh mesh_;
   Bounds bounds_;

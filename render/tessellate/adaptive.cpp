@@ -83,8 +83,9 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
       partlyBehind = true;
     }
   }
-  bool outside = !anyInFront || (!partlyBehind && (maxX < -margin || minX > camera.width() + margin ||
-                                                   maxY < -margin || minY > camera.height() + margin));
+  bool outside =
+      !anyInFront || (!partlyBehind && (maxX < -margin || minX > camera.width() + margin ||
+                                        maxY < -margin || minY > camera.height() + margin));
   probe.culled = outside || (closed && !anyFacing);
   probe.edgePixels.resize(n);
   for (int k = 0; k < n; ++k) {
@@ -141,12 +142,11 @@ void keepToTriangleBudget(const subdiv::LimitSurface& surface, const AdaptiveOpt
   double scaled = 1;
   while (triangles > options.maxTriangles) {
     if (!options.fitToBudget) {
-      throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
-                       std::string(options.stage) + " tessellation would make " +
-                           std::to_string(triangles) + " triangles: exceeds limit maxTriangles " +
-                           std::to_string(options.maxTriangles) +
-                           (std::string(options.stage) == "adaptive" ? " (raise params.dicingRate)"
-                                                                     : ""));
+      throw InputError(
+          InputError::Kind::LimitExceeded, "maxTriangles",
+          std::string(options.stage) + " tessellation would make " + std::to_string(triangles) +
+              " triangles: exceeds limit maxTriangles " + std::to_string(options.maxTriangles) +
+              (std::string(options.stage) == "adaptive" ? " (raise params.dicingRate)" : ""));
     }
     cancel.check();
     double factor = std::sqrt(static_cast<double>(options.maxTriangles) / triangles) * 0.95;
@@ -311,8 +311,8 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
       for (int c = 0; c < 3; ++c) {
         int i = patch.facets[t + c];
         out.indices.push_back(vertexOf[i]);
-        out.cornerUVs.push_back({static_cast<float>(patch.coords[2 * i]),
-                                 static_cast<float>(patch.coords[2 * i + 1])});
+        out.cornerUVs.push_back(
+            {static_cast<float>(patch.coords[2 * i]), static_cast<float>(patch.coords[2 * i + 1])});
       }
     }
   }

@@ -43,9 +43,9 @@ TriangleMesh tessellateCoarse(const subdiv::LimitSurface& surface) {
     offset += n;
     if (hole[f]) continue;
     for (int k = 1; k + 1 < n; ++k) {
-      out.indices.insert(out.indices.end(), {static_cast<uint32_t>(corners[0]),
-                                             static_cast<uint32_t>(corners[k]),
-                                             static_cast<uint32_t>(corners[k + 1])});
+      out.indices.insert(out.indices.end(),
+                         {static_cast<uint32_t>(corners[0]), static_cast<uint32_t>(corners[k]),
+                          static_cast<uint32_t>(corners[k + 1])});
     }
     addPolygonEdges(corners, seen, out.lines);
   }

@@ -36,8 +36,7 @@ struct UniformOptions {
 // and InputError(InvalidMesh) when limn's own rules cannot take the mesh (non-manifold).
 TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, const UniformOptions& options);
 // OpenSubdiv, not pushed to the limit.
-TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
-                               size_t maxTriangles);
+TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level, size_t maxTriangles);
 
 struct AdaptiveOptions {
   double dicingRate = 1.0;  // target edge length in pixels

@@ -2,12 +2,12 @@
 // then PrimvarRefiner::Limit) or by limn's own rules (render/rules: masks or factored, then the
 // limit masks). Both give every vertex of the last level its refined position, its limit
 // position and its limit normal; the mesh is assembled from those the same way.
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyRefiner.h>
+
 #include <cmath>
 #include <set>
 #include <string>
-
-#include <opensubdiv/far/primvarRefiner.h>
-#include <opensubdiv/far/topologyRefiner.h>
 
 #include "render/core/error.h"
 #include "render/rules/limit.h"
@@ -45,9 +45,12 @@ struct Refined {
 size_t predictedTriangles(const mesh::ControlMesh& cage, int level) {
   double count = 0;
   for (int n : cage.faceVertexCounts) {
-    if (level == 0) count += n - 2;
-    else if (cage.scheme == mesh::Scheme::Loop) count += 1;
-    else count += 2.0 * n / 4.0;
+    if (level == 0)
+      count += n - 2;
+    else if (cage.scheme == mesh::Scheme::Loop)
+      count += 1;
+    else
+      count += 2.0 * n / 4.0;
   }
   return static_cast<size_t>(count * std::pow(4.0, level));
 }
@@ -129,9 +132,9 @@ TriangleMesh assemble(const Refined& r, bool pushToLimit) {
     const int* fv = r.faceVertices.data() + r.faceOffsets[f];
     const int n = r.faceOffsets[f + 1] - r.faceOffsets[f];
     for (int k = 1; k + 1 < n; ++k) {
-      out.indices.insert(out.indices.end(), {static_cast<uint32_t>(fv[0]),
-                                             static_cast<uint32_t>(fv[k]),
-                                             static_cast<uint32_t>(fv[k + 1])});
+      out.indices.insert(out.indices.end(),
+                         {static_cast<uint32_t>(fv[0]), static_cast<uint32_t>(fv[k]),
+                          static_cast<uint32_t>(fv[k + 1])});
       Vec3 normal = cross(drawn[fv[k]] - drawn[fv[0]], drawn[fv[k + 1]] - drawn[fv[0]]);
       faceNormalSum[fv[0]] += normal;
       faceNormalSum[fv[k]] += normal;

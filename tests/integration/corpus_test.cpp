@@ -7,9 +7,9 @@
 #include <rapidjson/writer.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -197,9 +197,8 @@ std::string obliqueCamera(const std::string& obj, int size) {
 }
 
 std::unique_ptr<Rendered> render(const std::string& obj, const std::string& scheme,
-                                 const std::string& method, int size, bool reference,
-                                 int level = 0, const std::string& extraOutputs = "",
-                                 bool crossCheck = false) {
+                                 const std::string& method, int size, bool reference, int level = 0,
+                                 const std::string& extraOutputs = "", bool crossCheck = false) {
   std::ostringstream request;
   rapidjson::StringBuffer data;
   {
@@ -207,11 +206,10 @@ std::unique_ptr<Rendered> render(const std::string& obj, const std::string& sche
     writer.String(obj.c_str(), static_cast<rapidjson::SizeType>(obj.size()));
   }
   request << R"({"mesh":{"format":"obj","scheme":")" << scheme << R"(","data":)" << data.GetString()
-          << R"(},"camera":)" << obliqueCamera(obj, size) << R"(,"method":")"
-          << method << R"(","params":{"level":)" << level
-          << R"(,"dicingRate":1,"referenceCrossCheck":)" << (crossCheck ? "true" : "false")
-          << R"(},"outputs":["color")"
-          << extraOutputs << R"(],"reference":)" << (reference ? "true" : "false") << "}";
+          << R"(},"camera":)" << obliqueCamera(obj, size) << R"(,"method":")" << method
+          << R"(","params":{"level":)" << level << R"(,"dicingRate":1,"referenceCrossCheck":)"
+          << (crossCheck ? "true" : "false") << R"(},"outputs":["color")" << extraOutputs
+          << R"(],"reference":)" << (reference ? "true" : "false") << "}";
   HttpResponse response = post(CorpusServer::server->port(), "/v1/render", request.str());
   auto out = std::make_unique<Rendered>();
   out->status = response.status;
@@ -409,8 +407,8 @@ TEST_P(EveryShape, SilhouetteAgainstTheReference) {
     EXPECT_LT(stats["triangles"].GetUint64(), level4->body["stats"]["triangles"].GetUint64())
         << shape.name;
   }
-  std::printf("silhouette-result | %s | %s | %.3f | %llu |\n", shape.name.c_str(), kind.c_str(),
-              px, static_cast<unsigned long long>(stats["triangles"].GetUint64()));
+  std::printf("silhouette-result | %s | %s | %.3f | %llu |\n", shape.name.c_str(), kind.c_str(), px,
+              static_cast<unsigned long long>(stats["triangles"].GetUint64()));
 }
 
 std::string testName(const ::testing::TestParamInfo<Shape>& info) { return info.param.name; }

@@ -61,8 +61,8 @@ std::string body(const std::string& obj, const std::string& scheme, const std::s
   out << R"({"mesh":{"format":"obj","scheme":")" << scheme << R"(","data":)" << data.GetString()
       << R"(},"camera":{"width":)" << size << R"(,"height":)" << size
       << R"(,"eye":[2.2,1.6,3.4]},"method":")" << method << R"(","params":)" << params
-      << R"(,"shading":")" << shading << R"(","outputs":)" << outputs
-      << R"(,"reference":)" << (reference ? "true" : "false") << "}";
+      << R"(,"shading":")" << shading << R"(","outputs":)" << outputs << R"(,"reference":)"
+      << (reference ? "true" : "false") << "}";
   return out.str();
 }
 
@@ -104,7 +104,8 @@ double hausdorffPx(const rapidjson::Document& json) {
 }
 
 // Pixels where two images of the same size differ by more than `tolerance` in any channel.
-size_t differingPixels(const render::Image& a, const render::Image& b, float tolerance = 2.5f / 255) {
+size_t differingPixels(const render::Image& a, const render::Image& b,
+                       float tolerance = 2.5f / 255) {
   size_t count = 0;
   for (int y = 0; y < a.height; ++y) {
     for (int x = 0; x < a.width; ++x) {
@@ -134,7 +135,8 @@ TEST_F(RulesServer, OwnEnginesAnswerWhatOpenSubdivAnswers) {
       auto own = render(body(c.obj, c.scheme, "uniform",
                              R"({"level":3,"engine":")" + engine + "\"}", R"(["color"])", true));
       ASSERT_EQ(own->status, 200) << engine << ": " << own->text.substr(0, 300);
-      EXPECT_EQ(own->json["stats"]["triangles"].GetInt64(), far->json["stats"]["triangles"].GetInt64())
+      EXPECT_EQ(own->json["stats"]["triangles"].GetInt64(),
+                far->json["stats"]["triangles"].GetInt64())
           << engine;
       EXPECT_NEAR(hausdorffPx(own->json), hausdorffPx(far->json), 0.05) << engine;
       // The same mesh with the same normals: the same picture, give or take rounding.
@@ -150,8 +152,8 @@ TEST_F(RulesServer, PushToLimitPutsEveryVertexOnTheLimit) {
   for (const char* engine : {"opensubdiv", "masks"}) {
     const std::string params = std::string(R"({"level":2,"engine":")") + engine + "\"";
     auto refined = render(body(kCubeObj, "catmull-clark", "uniform", params + "}", "[]", true, 96));
-    auto pushed = render(
-        body(kCubeObj, "catmull-clark", "uniform", params + R"(,"pushToLimit":true})", "[]", true, 96));
+    auto pushed = render(body(kCubeObj, "catmull-clark", "uniform",
+                              params + R"(,"pushToLimit":true})", "[]", true, 96));
     ASSERT_EQ(refined->status, 200) << refined->text.substr(0, 300);
     ASSERT_EQ(pushed->status, 200) << pushed->text.substr(0, 300);
     // The geometry metric compares uniform's vertices with their own limit positions.
@@ -178,7 +180,8 @@ TEST_F(RulesServer, CageIsDrawnOverTheSurface) {
   for (int y = 0; y < color.height; ++y) {
     for (int x = 0; x < color.width; ++x) {
       bool differs = false;
-      for (int c = 0; c < 3; ++c) differs = differs || std::fabs(cage.at(x, y, c) - color.at(x, y, c)) > 0.02f;
+      for (int c = 0; c < 3; ++c)
+        differs = differs || std::fabs(cage.at(x, y, c) - color.at(x, y, c)) > 0.02f;
       if (!differs) continue;
       ++differing;
       red += cage.at(x, y, 0);
@@ -195,7 +198,8 @@ TEST_F(RulesServer, CageIsDrawnOverTheSurface) {
   RecordProperty("cagePixels", std::to_string(differing));
 
   // The reference has no cage; method limit draws none.
-  auto limit = render(body(kCubeObj, "catmull-clark", "limit", "{}", R"(["color","cage"])", false, 64));
+  auto limit =
+      render(body(kCubeObj, "catmull-clark", "limit", "{}", R"(["color","cage"])", false, 64));
   EXPECT_EQ(limit->status, 400);
   EXPECT_NE(limit->text.find("cage"), std::string::npos);
 }
@@ -247,8 +251,8 @@ TEST_F(RulesServer, EngineErrorsNameTheField) {
                                  R"(["color"])", false, 32));
   EXPECT_EQ(nonManifold->status, 422) << nonManifold->text;
   EXPECT_NE(nonManifold->text.find("edge 0-1"), std::string::npos) << nonManifold->text;
-  auto farTakesIt = render(body(fin, "catmull-clark", "uniform", R"({"level":1})",
-                                R"(["color"])", false, 32));
+  auto farTakesIt =
+      render(body(fin, "catmull-clark", "uniform", R"({"level":1})", R"(["color"])", false, 32));
   EXPECT_EQ(farTakesIt->status, 200) << farTakesIt->text.substr(0, 300);
 
   // Other methods ignore the engine, with a warning.

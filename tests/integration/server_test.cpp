@@ -274,7 +274,8 @@ TEST_F(ServerTest, EveryBadRequestGetsItsJsonErrorAndTheServerCarriesOn) {
       {"bad presubdivide", "POST", "/v1/render",
        renderBody("silhouette", 64, R"(, "params": {"presubdivide": 2})"), 400, "invalid_request"},
       {"bad contour", "POST", "/v1/render",
-       renderBody("silhouette", 64, R"(, "params": {"contour": "spline"})"), 400, "invalid_request"},
+       renderBody("silhouette", 64, R"(, "params": {"contour": "spline"})"), 400,
+       "invalid_request"},
       {"too many search steps", "POST", "/v1/render",
        renderBody("silhouette", 64, R"(, "params": {"searchSteps": 1000})"), 413, "too_large"},
       {"normal-map on uniform", "POST", "/v1/render",
@@ -482,10 +483,11 @@ TEST(ServerAccess, BearerTokenAndCors) {
   }
 
   HttpClient client(port);
-  HttpResponse preflight = client.request(
-      "OPTIONS", "/v1/render", "",
-      {{"Origin", "http://localhost:5173"}, {"Access-Control-Request-Method", "POST"},
-       {"Access-Control-Request-Headers", "authorization, content-type"}});
+  HttpResponse preflight =
+      client.request("OPTIONS", "/v1/render", "",
+                     {{"Origin", "http://localhost:5173"},
+                      {"Access-Control-Request-Method", "POST"},
+                      {"Access-Control-Request-Headers", "authorization, content-type"}});
   EXPECT_EQ(preflight.status, 204);
   EXPECT_EQ(preflight.header("Access-Control-Allow-Origin"), "http://localhost:5173");
   EXPECT_NE(preflight.header("Access-Control-Allow-Headers").find("Authorization"),

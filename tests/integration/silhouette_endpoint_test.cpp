@@ -27,15 +27,14 @@ const char* kCubeObj =
 const char* kObliqueCamera =
     R"("camera": {"eye": [2.5, 1.8, 4.0], "target": [0, 0, 0], "width": 256, "height": 256})";
 
-std::string cubeRequest(const std::string& extra = "",
-                        const std::string& camera = kObliqueCamera) {
+std::string cubeRequest(const std::string& extra = "", const std::string& camera = kObliqueCamera) {
   return std::string(R"({"mesh": {"format": "obj", "data": ")") + kCubeObj + "\"}, " + camera +
          extra + "}";
 }
 
 // Two cubes of side 1 in one JSON mesh, the first moved by `a`, the second by `b`.
 std::string twoCubesMesh(const double a[3], const double b[3]) {
-  const int corners[8][3] = {{-1, -1, 1}, {1, -1, 1},  {-1, 1, 1},  {1, 1, 1},
+  const int corners[8][3] = {{-1, -1, 1}, {1, -1, 1}, {-1, 1, 1},   {1, 1, 1},
                              {-1, 1, -1}, {1, 1, -1}, {-1, -1, -1}, {1, -1, -1}};
   const int faces[6][4] = {{0, 1, 3, 2}, {2, 3, 5, 4}, {4, 5, 7, 6},
                            {6, 7, 1, 0}, {1, 7, 5, 3}, {6, 0, 2, 4}};
@@ -75,8 +74,8 @@ std::string torusMesh(int ring = 24, int tube = 12) {
   auto id = [&](int i, int j) { return (i % ring) * tube + (j % tube); };
   for (int i = 0; i < ring; ++i) {
     for (int j = 0; j < tube; ++j) {
-      out << (i + j ? "," : "") << id(i, j) << "," << id(i + 1, j) << "," << id(i + 1, j + 1)
-          << "," << id(i, j + 1);
+      out << (i + j ? "," : "") << id(i, j) << "," << id(i + 1, j) << "," << id(i + 1, j + 1) << ","
+          << id(i, j + 1);
     }
   }
   out << "]}";
@@ -109,8 +108,7 @@ std::vector<Point> pointsOf(const rapidjson::Value& polyline) {
     out.push_back({p["position"][0].GetDouble(), p["position"][1].GetDouble(),
                    p["position"][2].GetDouble(), p["pixel"][0].GetDouble(),
                    p["pixel"][1].GetDouble(), p["normal"][0].GetDouble(),
-                   p["normal"][1].GetDouble(), p["normal"][2].GetDouble(),
-                   p["visible"].GetBool()});
+                   p["normal"][1].GetDouble(), p["normal"][2].GetDouble(), p["visible"].GetBool()});
   }
   return out;
 }
@@ -338,14 +336,13 @@ TEST_F(SilhouetteEndpointTest, BadRequestsName400FieldsAndTheServerCarriesOn) {
   const std::vector<Case> cases = {
       {"bad format", cubeRequest(R"(, "format": "png")"), 400, "invalid_request", "format"},
       {"format not a string", cubeRequest(R"(, "format": 3)"), 400, "invalid_request", "format"},
-      {"bad contour", cubeRequest(R"(, "params": {"contour": "bezier"})"), 400,
-       "invalid_request", "params.contour"},
+      {"bad contour", cubeRequest(R"(, "params": {"contour": "bezier"})"), 400, "invalid_request",
+       "params.contour"},
       {"bad presubdivide", cubeRequest(R"(, "params": {"presubdivide": 2})"), 400,
        "invalid_request", "params.presubdivide"},
-      {"searchSteps of the wrong type", cubeRequest(R"(, "params": {"searchSteps": "five"})"),
-       400, "invalid_request", "params.searchSteps"},
-      {"params not an object", cubeRequest(R"(, "params": [])"), 400, "invalid_request",
-       "params"},
+      {"searchSteps of the wrong type", cubeRequest(R"(, "params": {"searchSteps": "five"})"), 400,
+       "invalid_request", "params.searchSteps"},
+      {"params not an object", cubeRequest(R"(, "params": [])"), 400, "invalid_request", "params"},
       {"no mesh", std::string("{") + kObliqueCamera + "}", 400, "invalid_request", "mesh"},
       {"bad camera", cubeRequest("", R"("camera": {"width": "wide"})"), 400, "invalid_request",
        "camera.width"},
@@ -361,13 +358,14 @@ TEST_F(SilhouetteEndpointTest, BadRequestsName400FieldsAndTheServerCarriesOn) {
     EXPECT_STREQ(doc["error"]["code"].GetString(), c.code);
   }
   // Errors stay JSON even when the client asked for SVG.
-  HttpResponse svgError = post(port(), "/v1/silhouette", "{\"mesh\": ", {{"Accept", "image/svg+xml"}});
+  HttpResponse svgError =
+      post(port(), "/v1/silhouette", "{\"mesh\": ", {{"Accept", "image/svg+xml"}});
   EXPECT_EQ(svgError.status, 400);
   EXPECT_EQ(svgError.header("Content-Type"), "application/json");
   // A mesh the scheme cannot take is 422, an oversized image 413, a GET 405.
-  HttpResponse badMesh = post(
-      port(), "/v1/silhouette",
-      R"({"mesh": {"format": "obj", "data": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"}})");
+  HttpResponse badMesh =
+      post(port(), "/v1/silhouette",
+           R"({"mesh": {"format": "obj", "data": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"}})");
   EXPECT_EQ(badMesh.status, 422);
   HttpResponse tooBig =
       post(port(), "/v1/silhouette", cubeRequest("", R"("camera": {"width": 100000})"));

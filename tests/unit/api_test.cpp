@@ -16,7 +16,6 @@
 #include "api/obj_reader.h"
 #include "api/openapi.h"
 #include "api/render_api.h"
-
 #include "render/raster/rasterizer.h"
 
 namespace {
@@ -728,8 +727,7 @@ TEST(RenderRequest, WrongTypesNameTheField) {
 TEST(RenderRequest, UnknownMethodAndOutputListTheValidNames) {
   ApiError method = parseError(cubeRequest(R"(, "method": "magic")"));
   expectError(method, 400, "invalid_request");
-  EXPECT_TRUE(
-      contains(method.message, R"("coarse", "uniform", "adaptive", "limit", "silhouette")"))
+  EXPECT_TRUE(contains(method.message, R"("coarse", "uniform", "adaptive", "limit", "silhouette")"))
       << method.message;
   EXPECT_TRUE(contains(method.message, "\"magic\"")) << method.message;
 
@@ -1010,7 +1008,8 @@ TEST(HandleRender, TurnsEveryFailureIntoAJsonError) {
   EXPECT_EQ(bad.status, 400);
   EXPECT_STREQ(parseBody(bad)["error"]["code"].GetString(), "invalid_json");
 
-  api::Answer mesh = api::handleRender(objRequest("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), limits, context, cancel);
+  api::Answer mesh = api::handleRender(objRequest("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), limits,
+                                       context, cancel);
   EXPECT_EQ(mesh.status, 422);
   EXPECT_STREQ(parseBody(mesh)["error"]["code"].GetString(), "invalid_mesh");
 
@@ -1086,8 +1085,8 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
 }
 
 TEST(Config, AuthTokenAndCorsOrigins) {
-  api::ServiceConfig c = api::parseConfig(
-      R"({"authToken": "t0ken", "corsOrigins": ["http://localhost:5173", "*"]})");
+  api::ServiceConfig c =
+      api::parseConfig(R"({"authToken": "t0ken", "corsOrigins": ["http://localhost:5173", "*"]})");
   EXPECT_EQ(c.authToken, "t0ken");
   ASSERT_EQ(c.corsOrigins.size(), 2u);
   EXPECT_EQ(c.corsOrigins[1], "*");

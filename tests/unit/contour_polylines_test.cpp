@@ -1,12 +1,13 @@
 // Contour curves chained into polylines across faces, and polylines cut into pieces by
 // visibility: hand-made curves for the joining rules, then real limit-surface contours (a
 // sphere-like cube, smooth and creased tori) for the invariants a client relies on.
+#include "render/silhouette/contour_polylines.h"
+
 #include <gtest/gtest.h>
 
 #include <map>
 #include <set>
 
-#include "render/silhouette/contour_polylines.h"
 #include "render/silhouette/presubdivide.h"
 #include "render/silhouette/silhouette_mesh.h"
 #include "render/subdiv/limit_surface.h"

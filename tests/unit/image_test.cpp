@@ -1,10 +1,11 @@
 // Tests of render/image: PNG and EXR encoding into memory, decoding, and the 8-bit mappings of
 // the depth and normal passes that clients see in PNG answers.
+#include "render/core/image.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "render/core/image.h"
 #include "render/image/encode.h"
 #include "render/image/pixel_mapping.h"
 
@@ -104,7 +105,7 @@ TEST(ImageEncode, PngDepthOfOneDistanceIsWhite) {
 
 TEST(ImageEncode, PngNormalMapsToHalfOffsetRgb) {
   Image normal(3, 1, 3, 0.0f);
-  normal.at(0, 0, 2) = 1.0f;  // +Z
+  normal.at(0, 0, 2) = 1.0f;   // +Z
   normal.at(1, 0, 0) = -1.0f;  // -X
   // pixel 2 stays empty: zero-length normal
   Image back = decode(encode(normal, pass::kNormal, Format::Png).bytes);

@@ -1,19 +1,20 @@
 // Tests of render/metrics: the distance transform against brute force, the silhouette metrics
 // on masks whose answers are known by construction, the per-pixel image metrics on hand-made
 // ImageSets, and the geometry metric against a real OpenSubdiv limit surface.
+#include "render/metrics/metrics.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
-#include <functional>
-#include <numbers>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <vector>
 
-#include "render/metrics/metrics.h"
 #include "render/metrics/outline.h"
 #include "render/subdiv/limit_surface.h"
 #include "tests/unit/test_meshes.h"
@@ -124,8 +125,7 @@ TEST(DistanceTransform, NoFeatureIsInfinityEverywhere) {
 }
 
 TEST(DistanceTransform, RejectsBufferOfWrongSize) {
-  EXPECT_THROW(squaredDistanceTransform(std::vector<bool>(11, false), 4, 3),
-               std::invalid_argument);
+  EXPECT_THROW(squaredDistanceTransform(std::vector<bool>(11, false), 4, 3), std::invalid_argument);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -219,8 +219,8 @@ TEST(Silhouette, ImageBorderCountsAsUncovered) {
   const SilhouetteMetrics m = compareSilhouettes(full, inset, 1);
   EXPECT_DOUBLE_EQ(m.hausdorffPx, std::sqrt(2.0));
   const int borderPixels = 2 * 50 + 2 * 38, ringPixels = 2 * 48 + 2 * 36;
-  EXPECT_DOUBLE_EQ(m.meanPx, (borderPixels - 4 + 4 * std::sqrt(2.0) + ringPixels) /
-                                 (borderPixels + ringPixels));
+  EXPECT_DOUBLE_EQ(
+      m.meanPx, (borderPixels - 4 + 4 * std::sqrt(2.0) + ringPixels) / (borderPixels + ringPixels));
 }
 
 TEST(Silhouette, IouAndMismatchOnHandMadeMasks) {
@@ -455,8 +455,13 @@ TEST(Geometry, ChordsOfACurvedFaceLeaveTheSurfaceAndShrinkWithRefinement) {
 
   // The largest of the seven samples, worked out here independently.
   double worst = 0;
-  const double weights[7][3] = {{1, 0, 0},     {0, 1, 0},     {0, 0, 1},          {.5, .5, 0},
-                                {0, .5, .5},   {.5, 0, .5},   {1. / 3, 1. / 3, 1. / 3}};
+  const double weights[7][3] = {{1, 0, 0},
+                                {0, 1, 0},
+                                {0, 0, 1},
+                                {.5, .5, 0},
+                                {0, .5, .5},
+                                {.5, 0, .5},
+                                {1. / 3, 1. / 3, 1. / 3}};
   for (size_t t = 0; t < coarse.mesh.triangleCount(); ++t) {
     for (const auto& w : weights) {
       Vec3 p{0, 0, 0};

@@ -2,15 +2,13 @@
 // independent cross-check (Embree's own Catmull-Clark subdivision geometry): exactness at known
 // points, the outline against the limit surface's own silhouette, agreement of the two paths
 // and across supersampling factors, refusal of what Embree cannot represent.
-#include "render/oracle/reference.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 #include <thread>
@@ -20,6 +18,7 @@
 #include "render/metrics/metrics.h"
 #include "render/oracle/embree_device.h"
 #include "render/oracle/ray_caster.h"
+#include "render/oracle/reference.h"
 #include "render/oracle/reference_scene.h"
 #include "render/oracle/reference_tessellation.h"
 #include "render/oracle/triangle_scene.h"
@@ -43,8 +42,12 @@ Camera viewOf(const subdiv::LimitSurface& surface, int size, Vec3 offset = {0, 0
 }
 
 PassSelection allPasses(int supersample) {
-  return PassSelection{.color = true, .mask = true, .depth = true, .normal = true,
-                       .wireframe = false, .supersample = supersample};
+  return PassSelection{.color = true,
+                       .mask = true,
+                       .depth = true,
+                       .normal = true,
+                       .wireframe = false,
+                       .supersample = supersample};
 }
 
 double coverage(const Image& mask) {
@@ -279,7 +282,10 @@ TEST(Reference, CubeOutlineMatchesLimitSilhouette) {
       double lo = 0, hi = 1;
       for (int i = 0; i < 200; ++i) {  // golden-section on a unimodal section
         double a = hi - (hi - lo) * 0.618033988749895, b = lo + (hi - lo) * 0.618033988749895;
-        if (projectedX(a) < projectedX(b)) lo = a; else hi = b;
+        if (projectedX(a) < projectedX(b))
+          lo = a;
+        else
+          hi = b;
       }
       best = std::max(best, projectedX(0.5 * (lo + hi)));
     }
@@ -342,8 +348,7 @@ TEST(Reference, SupersampleFactorsAgree) {
   EXPECT_TRUE(r4.images.passes.empty());
   EXPECT_EQ(r8.images.supersample, 8);
   ASSERT_EQ(r8.images.supersampledMask.width, 160 * 8);
-  EXPECT_LT(meanOutlineShiftPx(r4.images.supersampledMask, 4, r8.images.supersampledMask, 8),
-            0.02);
+  EXPECT_LT(meanOutlineShiftPx(r4.images.supersampledMask, 4, r8.images.supersampledMask, 8), 0.02);
   // Upsample S = 4 to S = 8 (each pixel to 2 x 2): the outlines are within the quantisation of
   // the coarser mask (a quarter pixel) plus the half-pixel offset of sample positions.
   Image up(160 * 8, 160 * 8, 1);
@@ -419,8 +424,8 @@ TEST(Reference, HintMakesTheMaskExactWhereTheHintHasAnOutline) {
     for (int i = 0; i < hint.width; ++i) hint.at(i, j) = std::hypot(i - 20.0, j - 20.0) < 12;
   }
   ReferenceResult plain = renderReference(surface, camera, PassSelection{.supersample = S}, {});
-  ReferenceResult hinted = renderReference(surface, camera, PassSelection{.supersample = S}, {},
-                                           {.maskHint = &hint});
+  ReferenceResult hinted =
+      renderReference(surface, camera, PassSelection{.supersample = S}, {}, {.maskHint = &hint});
   EXPECT_GT(hinted.stats.refinedPixels, plain.stats.refinedPixels);
   EXPECT_EQ(hinted.images.supersampledMask.pixels, plain.images.supersampledMask.pixels);
 }
@@ -431,8 +436,10 @@ void expectOutlinesAgreeAcrossSupersampling(const subdiv::LimitSurface& surface,
                                             const Camera& camera, const std::string& name,
                                             double hausdorffPx = 0.05, double meanPx = 0.002) {
   ReferenceOptions options{.locateOutline = true};
-  ReferenceResult r4 = renderReference(surface, camera, PassSelection{.supersample = 4}, {}, options);
-  ReferenceResult r8 = renderReference(surface, camera, PassSelection{.supersample = 8}, {}, options);
+  ReferenceResult r4 =
+      renderReference(surface, camera, PassSelection{.supersample = 4}, {}, options);
+  ReferenceResult r8 =
+      renderReference(surface, camera, PassSelection{.supersample = 8}, {}, options);
   metrics::OutlineDistances d = metrics::compareOutlines(r4.outline, r8.outline, 1e9);
   std::cout << "[ outline  ] " << name << ": S = 4 vs 8: hausdorff " << d.hausdorffPx
             << " px, mean " << d.meanPx << " px, " << r4.outline.points.size() << " / "
@@ -457,8 +464,8 @@ TEST(Reference, OutlineOfTheReferenceTessellationMeshIsTheReferenceOutline) {
   ReferenceResult r = renderReference(surface, camera, PassSelection{.supersample = 4}, {},
                                       {.locateOutline = true});
   std::shared_ptr<const ReferenceScene> scene = buildReferenceScene(surface, camera, {});
-  metrics::Outline o = locateMeshOutline(scene->tessellation.mesh, camera,
-                                         r.images.supersampledMask, 4, {});
+  metrics::Outline o =
+      locateMeshOutline(scene->tessellation.mesh, camera, r.images.supersampledMask, 4, {});
   metrics::OutlineDistances d = metrics::compareOutlines(o, r.outline, 1e9);
   EXPECT_LT(d.hausdorffPx, 2e-3);
 }
@@ -471,7 +478,8 @@ TEST(ReferenceCache, SecondRequestForTheSameViewReusesTheScene) {
   ReferenceResult second = renderReference(surface, camera, allPasses(4), {}, {.cache = &cache});
   EXPECT_FALSE(first.stats.sceneCached);
   EXPECT_TRUE(second.stats.sceneCached);
-  EXPECT_EQ(first.images.passes.at(pass::kColor).pixels, second.images.passes.at(pass::kColor).pixels);
+  EXPECT_EQ(first.images.passes.at(pass::kColor).pixels,
+            second.images.passes.at(pass::kColor).pixels);
   EXPECT_EQ(first.images.supersampledMask.pixels, second.images.supersampledMask.pixels);
   ReferenceSceneCache::Counters c = cache.counters();
   EXPECT_EQ(c.hits, 1u);
@@ -481,7 +489,8 @@ TEST(ReferenceCache, SecondRequestForTheSameViewReusesTheScene) {
 
   // Another camera, or the same mesh with one point moved, is another scene.
   Camera other = viewOf(surface, 96, {1.5, 0.8, 3.0});
-  EXPECT_FALSE(renderReference(surface, other, allPasses(0), {}, {.cache = &cache}).stats.sceneCached);
+  EXPECT_FALSE(
+      renderReference(surface, other, allPasses(0), {}, {.cache = &cache}).stats.sceneCached);
   ControlMesh moved = testing::torus(12, 8, true);
   moved.points[3].z += 1e-9;
   subdiv::LimitSurface movedSurface(moved);
@@ -492,7 +501,8 @@ TEST(ReferenceCache, SecondRequestForTheSameViewReusesTheScene) {
 
 TEST(ReferenceCache, StaysWithinItsBytes) {
   subdiv::LimitSurface surface(testing::cube());
-  std::shared_ptr<const ReferenceScene> probe = buildReferenceScene(surface, viewOf(surface, 64), {});
+  std::shared_ptr<const ReferenceScene> probe =
+      buildReferenceScene(surface, viewOf(surface, 64), {});
   ReferenceSceneCache cache(probe->bytes * 5 / 2);  // room for two scenes of that size
   for (int k = 0; k < 5; ++k) {
     Camera camera = viewOf(surface, 64, {0.1 * k, 0.2, 2.0});
@@ -599,8 +609,8 @@ TEST(CrossCheck, RefusesWhatEmbreeCannotRepresent) {
 
   // Three faces on one edge.
   ControlMesh fin;
-  fin.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {1, 0, 1}, {0, 0, 1}, {1, -1, 0},
-                {0, -1, 0}};
+  fin.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0},  {0, 1, 0},
+                {1, 0, 1}, {0, 0, 1}, {1, -1, 0}, {0, -1, 0}};
   testing::addFace(fin, {0, 1, 2, 3});
   testing::addFace(fin, {1, 0, 5, 4});
   testing::addFace(fin, {0, 1, 6, 7});
@@ -692,7 +702,8 @@ TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
       std::cout << "[ corpus   ] " << name << ": no cross-check: " << whyNot << "\n";
       continue;
     }
-    ReferenceResult r = renderReference(*surface, camera, allPasses(S), {}, {.locateOutline = true});
+    ReferenceResult r =
+        renderReference(*surface, camera, allPasses(S), {}, {.locateOutline = true});
     metrics::SilhouetteMetrics sm =
         metrics::compareSilhouettes(*embree, r.images.supersampledMask, S);
     metrics::Outline embreeOutline;
@@ -713,7 +724,6 @@ TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
   EXPECT_GT(compared, 10);
 }
 
-
 TEST(Corpus, OutlineAgreesAcrossSupersampling) {
   std::filesystem::path dir = corpusDir();
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no corpus at " << dir;
@@ -733,8 +743,8 @@ TEST(Corpus, OutlineAgreesAcrossSupersampling) {
     // resolved further at S = 8 than at S = 4 (docs/engine.md): the maximum is bounded by 0.75 px
     // there, not 0.05 px as on outlines without such features, and the mean by 0.004 px.
     Camera camera = viewOf(*surface, 128, Vec3{0.3, 0.45, 0.85} * surface->bounds().diagonal());
-    expectOutlinesAgreeAcrossSupersampling(*surface, camera, entry.path().filename().string(),
-                                           0.75, 0.004);
+    expectOutlinesAgreeAcrossSupersampling(*surface, camera, entry.path().filename().string(), 0.75,
+                                           0.004);
     ++compared;
   }
   EXPECT_GT(compared, 30);
@@ -750,8 +760,9 @@ double msOf(const std::function<void()>& f) {
   for (int run = 0; run < 3; ++run) {
     auto start = std::chrono::steady_clock::now();
     f();
-    best = std::min(best, std::chrono::duration<double, std::milli>(
-                              std::chrono::steady_clock::now() - start).count());
+    best = std::min(
+        best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                  .count());
   }
   return best;
 }
@@ -763,8 +774,8 @@ void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, i
   const ReferenceStats& st = r.stats;
   std::printf("%s (%d faces) at %d^2, S = %d, %u threads\n", name.c_str(), m.faceCount(), size, S,
               std::thread::hardware_concurrency());
-  std::printf("  dense tessellation  %9.1f ms  %zu triangles, %zu outline faces\n",
-              st.tessellateMs, st.triangles, st.outlineFaces);
+  std::printf("  dense tessellation  %9.1f ms  %zu triangles, %zu outline faces\n", st.tessellateMs,
+              st.triangles, st.outlineFaces);
   std::printf("  BVH (high)          %9.1f ms\n", st.bvhMs);
   std::printf("  primary rays        %9.1f ms  %d rays (packets of 16)\n", st.traceMs, size * size);
   std::printf("  Newton + shading    %9.1f ms  %zu hits, %zu not refined\n", st.newtonMs, st.hits,
@@ -774,7 +785,8 @@ void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, i
 
   // Alternatives, on the same tessellation.
   ReferenceTessellation tess = tessellateForReference(surface, camera, {});
-  for (RTCBuildQuality q : {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH}) {
+  for (RTCBuildQuality q :
+       {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH}) {
     EmbreeScene scene;
     double build = msOf([&] { scene = buildTriangleScene(tess.mesh, q); });
     double p16 = msOf([&] { castClosestHits(scene.get(), camera, RayPacking::Packet16, {}); });
@@ -782,14 +794,18 @@ void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, i
     Camera fine = camera.scaled(S);
     double m16 = msOf([&] { castCoverage(scene.get(), fine, RayPacking::Packet16, {}); });
     double m1 = msOf([&] { castCoverage(scene.get(), fine, RayPacking::Single, {}); });
-    std::printf("  quality %-6s BVH %7.1f ms | primary: packet16 %7.1f, single %7.1f ms | "
-                "mask: packet16 %7.1f, single %7.1f ms\n",
-                q == RTC_BUILD_QUALITY_LOW ? "low" : q == RTC_BUILD_QUALITY_MEDIUM ? "medium" : "high",
-                build, p16, p1, m16, m1);
+    std::printf(
+        "  quality %-6s BVH %7.1f ms | primary: packet16 %7.1f, single %7.1f ms | "
+        "mask: packet16 %7.1f, single %7.1f ms\n",
+        q == RTC_BUILD_QUALITY_LOW      ? "low"
+        : q == RTC_BUILD_QUALITY_MEDIUM ? "medium"
+                                        : "high",
+        build, p16, p1, m16, m1);
   }
   std::string whyNot;
   std::optional<Image> embree;
-  double subdivMs = msOf([&] { embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot); });
+  double subdivMs =
+      msOf([&] { embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot); });
   if (embree) {
     metrics::SilhouetteMetrics sm =
         metrics::compareSilhouettes(*embree, r.images.supersampledMask, S);

@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
-#include <cmath>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -62,8 +62,8 @@ Camera perspectiveCamera(int width = 64, int height = 48) {
 }
 
 Camera orthographicCamera(int width = 64, int height = 48) {
-  return Camera({0.4, 0.3, 5}, {0, 0.2, 0}, {0, 1, 0}, 35.0, Projection::Orthographic, 3.0,
-                width, height, 1.0, 10.0);
+  return Camera({0.4, 0.3, 5}, {0, 0.2, 0}, {0, 1, 0}, 35.0, Projection::Orthographic, 3.0, width,
+                height, 1.0, 10.0);
 }
 
 // Where the pixel centre (x, y) of `camera` meets the plane of the tilted quad, if it does.
@@ -298,7 +298,8 @@ TEST_F(RasterTest, BackFacesKeepTheirWindingNormalAndGetTheBackAlbedo) {
       for (int k = 0; k < 3; ++k) EXPECT_NEAR(images.passes[pass::kNormal].at(x, y, k), n[k], 1e-3);
       float rgb[3];
       shading::shade(n, normalize(camera.eye() - hit), rgb);
-      for (int k = 0; k < 3; ++k) EXPECT_NEAR(images.passes[pass::kColor].at(x, y, k), rgb[k], 1e-3);
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(images.passes[pass::kColor].at(x, y, k), rgb[k], 1e-3);
       ++checked;
     }
   }
@@ -383,8 +384,8 @@ TEST_F(RasterTest, LargeFramesAndSupersampledMasksAreTiled) {
   // 2100 px wide: two frame tiles (2048 cap); S = 8 makes 16800 x 400: five coverage tiles
   // (4096 cap). The view is shifted so that the quad straddles the seams at x = 2048 (frame)
   // and x = 16384 (coverage).
-  Camera camera(Vec3{0.4 - 13.75, 0.3, 5}, Vec3{-13.75, 0.2, 0}, Vec3{0, 1, 0}, 10.0, Projection::Perspective,
-                2.0, 2100, 50, 1.0, 10.0);
+  Camera camera(Vec3{0.4 - 13.75, 0.3, 5}, Vec3{-13.75, 0.2, 0}, Vec3{0, 1, 0}, 10.0,
+                Projection::Perspective, 2.0, 2100, 50, 1.0, 10.0);
   PassSelection passes;
   passes.mask = passes.depth = true;
   passes.supersample = 8;
@@ -444,10 +445,9 @@ TEST_F(RasterTest, WireframeDiffersFromColorOnlyAlongEdges) {
       if (same) continue;
       ++drawn;
       double cx = x + 0.5, cy = y + 0.5;
-      double d = std::min({segmentDistance(px[0], px[1], cx, cy),
-                           segmentDistance(px[1], px[2], cx, cy),
-                           segmentDistance(px[2], px[3], cx, cy),
-                           segmentDistance(px[3], px[0], cx, cy)});
+      double d =
+          std::min({segmentDistance(px[0], px[1], cx, cy), segmentDistance(px[1], px[2], cx, cy),
+                    segmentDistance(px[2], px[3], cx, cy), segmentDistance(px[3], px[0], cx, cy)});
       double diagonal = segmentDistance(px[0], px[2], cx, cy);
       ASSERT_LE(std::min(d, diagonal), 1.0) << "pixel " << x << ", " << y << " is off the edges";
       onDiagonal += diagonal < d;
@@ -467,10 +467,9 @@ TEST_F(RasterTest, WireframeDiffersFromColorOnlyAlongEdges) {
       if (images.passes[pass::kWireframe].at(x, y, 0) == images.passes[pass::kColor].at(x, y, 0))
         continue;
       double cx = x + 0.5, cy = y + 0.5;
-      double d = std::min({segmentDistance(px[0], px[1], cx, cy),
-                           segmentDistance(px[1], px[2], cx, cy),
-                           segmentDistance(px[2], px[3], cx, cy),
-                           segmentDistance(px[3], px[0], cx, cy)});
+      double d =
+          std::min({segmentDistance(px[0], px[1], cx, cy), segmentDistance(px[1], px[2], cx, cy),
+                    segmentDistance(px[2], px[3], cx, cy), segmentDistance(px[3], px[0], cx, cy)});
       EXPECT_LE(d, 1.0) << x << ", " << y;
     }
   }
@@ -499,7 +498,8 @@ TEST_F(RasterTest, HiddenEdgesDoNotShowInTheWireframe) {
 
 TEST_F(RasterTest, NearerSurfaceWinsRegardlessOfDrawOrder) {
   Camera camera = perspectiveCamera();
-  TriangleMesh nearQuad = quad({-0.5, -0.5, 1.5}, {0.5, -0.5, 1.5}, {0.5, 0.5, 1.5}, {-0.5, 0.5, 1.5});
+  TriangleMesh nearQuad =
+      quad({-0.5, -0.5, 1.5}, {0.5, -0.5, 1.5}, {0.5, 0.5, 1.5}, {-0.5, 0.5, 1.5});
   TriangleMesh farQuad = quad({-2, -2, -1}, {2, -2, -1}, {2, 2, -1}, {-2, 2, -1});
   PassSelection passes;
   passes.depth = true;
@@ -545,9 +545,9 @@ TEST_F(RasterTest, RejectsBadMeshesAndCameras) {
   mesh.normals.pop_back();
   EXPECT_THROW(rasterizer().render(mesh, perspectiveCamera(), allPasses(), Shading::Flat),
                std::invalid_argument);
-  EXPECT_THROW(rasterizer().render(tiltedQuad(), perspectiveCamera(0, 10), allPasses(),
-                                   Shading::Flat),
-               std::invalid_argument);
+  EXPECT_THROW(
+      rasterizer().render(tiltedQuad(), perspectiveCamera(0, 10), allPasses(), Shading::Flat),
+      std::invalid_argument);
   // Still usable afterwards.
   Camera camera = perspectiveCamera();
   expectTiltedQuad(rasterizer().render(tiltedQuad(), camera, allPasses(), Shading::Flat), camera);
@@ -582,8 +582,8 @@ TEST_F(RasterTest, SphereOfAHundredThousandTriangles) {
   rasterizer().render(mesh, camera, allPasses(4), Shading::Smooth);  // warm-up
   auto start = std::chrono::steady_clock::now();
   ImageSet images = rasterizer().render(mesh, camera, allPasses(4), Shading::Smooth);
-  double ms = std::chrono::duration<double, std::milli>(
-                  std::chrono::steady_clock::now() - start).count();
+  double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::printf("1024^2 color+mask+depth+normal + S=4 mask, %zu triangles: %.1f ms\n",
               mesh.triangleCount(), ms);
   // Silhouette of a sphere seen from distance 4: a circle of angular radius asin(1/4).
@@ -613,8 +613,8 @@ TEST_F(RasterTest, MillionsOfTriangles) {
       uint32_t a = y * (n + 1) + x, b = a + n + 1;
       for (uint32_t k : {a, a + 1, b + 1, a, b + 1, b}) mesh.indices.push_back(k);
     }
-  Camera camera({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 30.0, Projection::Orthographic, 1.5, 256, 256,
-                1.0, 5.0);
+  Camera camera({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 30.0, Projection::Orthographic, 1.5, 256, 256, 1.0,
+                5.0);
   PassSelection passes;
   passes.mask = passes.depth = true;
   ImageSet images = rasterizer().render(mesh, camera, passes, Shading::Smooth);
@@ -694,9 +694,8 @@ int expectOverlayPass(const Image& color, const Image& lines, const Camera& came
       // Where segments cross, the pixel may hold the other one's colour.
       bool lineColored = false;
       for (const PixelSegment& other : segments) {
-        lineColored = lineColored ||
-                      (segmentDistance(other.a, other.b, x + 0.5, y + 0.5) <= 1.5 &&
-                       pixelHasColor(lines, x, y, other.color));
+        lineColored = lineColored || (segmentDistance(other.a, other.b, x + 0.5, y + 0.5) <= 1.5 &&
+                                      pixelHasColor(lines, x, y, other.color));
       }
       drawn += lineColored;
       if (d < onLine && visible(x, y, *s)) {
@@ -708,8 +707,8 @@ int expectOverlayPass(const Image& color, const Image& lines, const Camera& came
 }
 
 Camera sphereCamera(int width = 160, int height = 120) {
-  return Camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 2.0, width,
-                height, 1.0, 10.0);
+  return Camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 2.0, width, height,
+                1.0, 10.0);
 }
 
 PassSelection colorAndMask() {
@@ -765,8 +764,8 @@ TEST_F(RasterTest, OccludedOverlayIsHiddenBehindTheSurface) {
   const std::vector<PixelSegment> segments = projectOverlay(camera, behind);
   int drawn = expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("behind"), camera,
                                 segments, [](int, int, const PixelSegment&) { return true; });
-  const double length = std::hypot(segments[0].b.x - segments[0].a.x,
-                                   segments[0].b.y - segments[0].a.y);
+  const double length =
+      std::hypot(segments[0].b.x - segments[0].a.x, segments[0].b.y - segments[0].a.y);
   EXPECT_GT(drawn, 1.8 * length);
 
   // A line from behind the sphere out past its silhouette shows only outside it.
@@ -783,7 +782,8 @@ TEST_F(RasterTest, OccludedOverlayIsHiddenBehindTheSurface) {
                     projectOverlay(camera, out), [&](int x, int y, const PixelSegment& s) {
                       const double r = std::hypot(x + 0.5 - 80, y + 0.5 - 60);
                       if (std::fabs(r - radiusPx) < 2) return false;
-                      const bool lineColored = pixelHasColor(images.passes.at("out"), x, y, s.color);
+                      const bool lineColored =
+                          pixelHasColor(images.passes.at("out"), x, y, s.color);
                       if (mask.at(x, y) > 0) {
                         EXPECT_FALSE(lineColored) << x << ", " << y;
                         ++hidden;
@@ -816,12 +816,12 @@ TEST_F(RasterTest, OverlayLinesLyingOnTheSurfaceStayVisible) {
   auto onQuad = quadPoint;
   LineOverlay overlay;
   overlay.pass = "on";
-  overlay.points = {onQuad(0.1, 0.2), onQuad(0.9, 0.7), Vec3f(kQuad[0]), Vec3f(kQuad[2]),
-                    Vec3f(kQuad[0]), Vec3f(kQuad[1])};
+  overlay.points = {onQuad(0.1, 0.2), onQuad(0.9, 0.7), Vec3f(kQuad[0]),
+                    Vec3f(kQuad[2]),  Vec3f(kQuad[0]),  Vec3f(kQuad[1])};
   overlay.colors = {Rgba{255, 0, 0, 255}, Rgba{0, 0, 255, 255}, Rgba{0, 255, 0, 255}};
   for (const Camera& camera : {perspectiveCamera(96, 72), orthographicCamera(96, 72)}) {
-    ImageSet images = rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat,
-                                          {overlay});
+    ImageSet images =
+        rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat, {overlay});
     int drawn = expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("on"), camera,
                                   projectOverlay(camera, overlay),
                                   [](int, int, const PixelSegment&) { return true; });
@@ -896,7 +896,8 @@ TEST_F(RasterTest, OverlaysAreSeparatePassesAndBlendWithTheirAlpha) {
   colorOnly.color = true;
   const Image color =
       rasterizer().render(tiltedQuad(), camera, colorOnly, Shading::Flat).passes.at(pass::kColor);
-  const std::vector<PixelSegment> segA = projectOverlay(camera, a), segB = projectOverlay(camera, b);
+  const std::vector<PixelSegment> segA = projectOverlay(camera, a),
+                                  segB = projectOverlay(camera, b);
   const float alpha = 128 / 255.0f;
   int blended = 0;
   for (int y = 0; y < camera.height(); ++y) {
@@ -932,13 +933,13 @@ TEST_F(RasterTest, OverlayCrossingTheNearPlaneIsCut) {
   overlay.points = {Vec3f(0.1f, 0.05f, 1.5f), Vec3f(0.3f, 0.15f, 8)};
   overlay.colors = {Rgba{0, 255, 255, 255}};
   overlay.occluded = false;
-  ImageSet images = rasterizer().render(sphere(1.0, 24, 32), camera, colorAndMask(),
-                                        Shading::Smooth, {overlay});
+  ImageSet images =
+      rasterizer().render(sphere(1.0, 24, 32), camera, colorAndMask(), Shading::Smooth, {overlay});
   // The visible part ends on the near plane: z = 3, at t = 1.5 / 6.5 along the segment.
   const double t = 1.5 / 6.5;
   LineOverlay visible = overlay;
-  visible.points[1] = Vec3f(0.1f + 0.2f * static_cast<float>(t),
-                            0.05f + 0.1f * static_cast<float>(t), 3.0f);
+  visible.points[1] =
+      Vec3f(0.1f + 0.2f * static_cast<float>(t), 0.05f + 0.1f * static_cast<float>(t), 3.0f);
   int drawn = expectOverlayPass(images.passes.at(pass::kColor), images.passes.at("near"), camera,
                                 projectOverlay(camera, visible),
                                 [](int, int, const PixelSegment&) { return true; });
@@ -953,8 +954,8 @@ TEST_F(RasterTest, OverlaysAreTiledLikeTheOtherPasses) {
   overlay.pass = "seam";
   overlay.points = {quadPoint(0.02, 0.3), quadPoint(0.98, 0.6)};
   overlay.colors = {Rgba{255, 128, 0, 255}};
-  ImageSet images = rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat,
-                                        {overlay});
+  ImageSet images =
+      rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat, {overlay});
   const std::vector<PixelSegment> segments = projectOverlay(camera, overlay);
   ASSERT_LT(std::min(segments[0].a.x, segments[0].b.x), 2040);
   ASSERT_GT(std::max(segments[0].a.x, segments[0].b.x), 2056);
@@ -989,8 +990,8 @@ TEST_F(RasterTest, RejectsMalformedOverlays) {
   bad = good;
   bad.pass.clear();
   rejects({bad});
-  for (const char* builtIn : {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal,
-                              pass::kWireframe}) {
+  for (const char* builtIn :
+       {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal, pass::kWireframe}) {
     bad = good;
     bad.pass = builtIn;
     rejects({bad});
@@ -1005,8 +1006,8 @@ TEST_F(RasterTest, RejectsMalformedOverlays) {
   // An overlay without segments is the colour pass; the rasteriser is still usable.
   LineOverlay empty;
   empty.pass = "empty";
-  ImageSet images = rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat,
-                                        {empty, good});
+  ImageSet images =
+      rasterizer().render(tiltedQuad(), camera, colorAndMask(), Shading::Flat, {empty, good});
   EXPECT_EQ(images.passes.at("empty").pixels, images.passes.at(pass::kColor).pixels);
   EXPECT_EQ(images.passes.size(), 4u);
 }
@@ -1065,9 +1066,8 @@ TEST_F(RasterTest, NormalMapShadingSamplesTheMapBilinearly) {
         const Vec3 got{normal.at(x, y, 0), normal.at(x, y, 1), normal.at(x, y, 2)};
         EXPECT_NEAR(length(got), 1.0, 1e-5);
         worst = std::max(worst, length(got - expected));
-        Vec3 toEye = camera.projection() == Projection::Perspective
-                         ? normalize(camera.eye() - hit)
-                         : -camera.forward();
+        Vec3 toEye = camera.projection() == Projection::Perspective ? normalize(camera.eye() - hit)
+                                                                    : -camera.forward();
         float rgb[3];
         shading::shade(got, toEye, rgb);
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(color.at(x, y, k), rgb[k], 1e-4);

@@ -4,6 +4,7 @@
 // positions and normals, the factored method against the masks, known weights and values.
 // Shapes a rule set cannot take are reported as skipped, with the reason.
 #include <gtest/gtest.h>
+#include <opensubdiv/far/primvarRefiner.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,8 +14,6 @@
 #include <memory>
 #include <random>
 #include <sstream>
-
-#include <opensubdiv/far/primvarRefiner.h>
 
 #include "api/obj_reader.h"
 #include "render/core/error.h"
@@ -65,7 +64,8 @@ std::vector<Shape> allShapes() {
     std::sort(files.begin(), files.end());
     for (const fs::path& path : files) {
       std::string name = path.stem().string();
-      if (name.rfind("catmark_", 0) == 0) shapes.push_back({name, readCorpus(path, Scheme::CatmullClark)});
+      if (name.rfind("catmark_", 0) == 0)
+        shapes.push_back({name, readCorpus(path, Scheme::CatmullClark)});
       if (name.rfind("loop_", 0) == 0) shapes.push_back({name, readCorpus(path, Scheme::Loop)});
     }
     for (const char* name : {"catmark_chaikin0", "loop_chaikin0"}) {
@@ -238,7 +238,8 @@ TEST_P(EveryShape, LimitPositionsAndNormalsMatchOpenSubdiv) {
       worstPosition = std::max(worstPosition, gap);
       EXPECT_LE(gap, tolerance) << shape.name << " level " << l << " vertex " << v;
       Vec3 farNormal = cross(far.tangent1[v].vec(), far.tangent2[v].vec());
-      if (length(farNormal) <= 1e-12 * length(far.tangent1[v].vec()) * length(far.tangent2[v].vec())) {
+      if (length(farNormal) <=
+          1e-12 * length(far.tangent1[v].vec()) * length(far.tangent2[v].vec())) {
         ++degenerate;  // OpenSubdiv has no normal here (e.g. a corner between collinear edges)
         continue;
       }
@@ -316,9 +317,10 @@ TEST_P(EveryShape, LimitIsInvariantUnderRefinement) {
   RecordProperty("dartTurnDeg", sci(dartTurn));
   RecordProperty("irregularCreaseTurnDeg", sci(creaseTurn));
   if (dartMove > 1e-12 || dartTurn > 1e-6 || creaseTurn > 1e-6) {
-    std::printf("limit-approximation | %s | dart move %.2e of the diagonal, dart normal %.3f deg, "
-                "irregular crease normal %.3f deg |\n",
-                shape.name.c_str(), dartMove, dartTurn, creaseTurn);
+    std::printf(
+        "limit-approximation | %s | dart move %.2e of the diagonal, dart normal %.3f deg, "
+        "irregular crease normal %.3f deg |\n",
+        shape.name.c_str(), dartMove, dartTurn, creaseTurn);
   }
 }
 
@@ -461,7 +463,8 @@ TEST(KnownValues, RegularCatmullClarkVertexLimitIsTheBicubicBSpline) {
       const double w[3] = {1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0};
       Vec3 bspline{0, 0, 0};
       for (int dj = -1; dj <= 1; ++dj) {
-        for (int di = -1; di <= 1; ++di) bspline += w[dj + 1] * w[di + 1] * m.points[v + dj * (n + 1) + di];
+        for (int di = -1; di <= 1; ++di)
+          bspline += w[dj + 1] * w[di + 1] * m.points[v + dj * (n + 1) + di];
       }
       EXPECT_NEAR(length(limit.positions[v] - bspline), 0.0, 1e-14) << "vertex " << v;
       // ... and OpenSubdiv's limit surface (Bfr) at the same corner of a face around it.

@@ -32,12 +32,12 @@ Measured measure(const subdiv::LimitSurface& exact, const subdiv::LimitSurface& 
   oracle::ReferenceResult reference = oracle::renderReference(
       exact, camera, PassSelection{.mask = true, .supersample = kS}, CancelToken());
   SilhouetteMesh built = buildSilhouetteMesh(drawn, camera, options, CancelToken());
-  ImageSet images = rasterizer().render(built.mesh, camera,
-                                        PassSelection{.mask = true, .supersample = kS},
-                                        Shading::Smooth);
-  return {metrics::compareSilhouettes(images.supersampledMask, reference.images.supersampledMask, kS)
-              .hausdorffPx,
-          built.stats};
+  ImageSet images = rasterizer().render(
+      built.mesh, camera, PassSelection{.mask = true, .supersample = kS}, Shading::Smooth);
+  return {
+      metrics::compareSilhouettes(images.supersampledMask, reference.images.supersampledMask, kS)
+          .hausdorffPx,
+      built.stats};
 }
 
 // A camera on a circle around the mesh's centre, `degrees` around the vertical axis, a little
@@ -125,8 +125,8 @@ TEST(SilhouetteRender, DoubleCrossingsAndBoundariesAreDrawn) {
   subdiv::LimitSurface exact(m);
   Vec3 target{0, 0, 0.3};
   Vec3 dir = normalize(Vec3{-1, 0.35, -0.58});
-  Camera camera(target - dir * 20.0, target, {0, 0, 1}, 35, Projection::Orthographic, 6.0, 512,
-                512, 1, 40);
+  Camera camera(target - dir * 20.0, target, {0, 0, 1}, 35, Projection::Orthographic, 6.0, 512, 512,
+                1, 40);
   SilhouetteOptions options;
   options.search.edgeSamples = 1;  // only the slope test can find the pairs
   Measured result = measure(exact, exact, camera, options);

@@ -67,8 +67,8 @@ TEST(ContourSearch, FindsBothCrossingsOfAnEdgeWhoseEndsAgree) {
     for (int e = 0; e < base.GetNumEdges(); ++e) {
       auto ends = base.GetEdgeVertices(e);
       Vec3 a = surface.mesh().points[ends[0]], b = surface.mesh().points[ends[1]];
-      bool leftFlank = std::fabs(a.y - b.y) < 1e-9 && std::min(a.x, b.x) == -1 &&
-                       std::max(a.x, b.x) == 0;
+      bool leftFlank =
+          std::fabs(a.y - b.y) < 1e-9 && std::min(a.x, b.x) == -1 && std::max(a.x, b.x) == 0;
       if (!leftFlank) continue;
       int crossings = 0;
       for (const EdgePoint& p : search.edgePoints[e]) {
@@ -120,12 +120,15 @@ TEST(SilhouetteMesh, IsWatertightOnClosedMeshes) {
       SilhouetteMesh result = buildSilhouetteMesh(surface, camera, options, CancelToken());
       const auto& m = result.mesh;
       using Key = std::tuple<float, float, float>;
-      auto key = [&](uint32_t i) { return Key{m.positions[i].x, m.positions[i].y, m.positions[i].z}; };
+      auto key = [&](uint32_t i) {
+        return Key{m.positions[i].x, m.positions[i].y, m.positions[i].z};
+      };
       std::map<std::pair<Key, Key>, int> uses;
       for (size_t t = 0; t < m.triangleCount(); ++t) {
         // Triangles of zero area (where a face's parameterisation pinches to a point next to
         // a sharp crease) cover nothing and are left out of the count.
-        Vec3 p0 = m.positions[m.indices[3 * t]].toDouble(), p1 = m.positions[m.indices[3 * t + 1]].toDouble(),
+        Vec3 p0 = m.positions[m.indices[3 * t]].toDouble(),
+             p1 = m.positions[m.indices[3 * t + 1]].toDouble(),
              p2 = m.positions[m.indices[3 * t + 2]].toDouble();
         if (length(cross(p1 - p0, p2 - p0)) < 1e-12) continue;
         for (int k = 0; k < 3; ++k) {
@@ -144,8 +147,8 @@ TEST(SilhouetteMesh, IsWatertightOnClosedMeshes) {
 
 TEST(FaceTriangulation, CoversTheFaceWithStraightRunsKept) {
   // Unit square with two extra points on its bottom edge and a curve from the bottom to the top.
-  std::vector<Vec2> uv = {{0, 0}, {0.3, 0}, {0.6, 0}, {1, 0}, {1, 1}, {0.5, 1}, {0, 1},
-                          {0.45, 0.3}, {0.55, 0.7}};
+  std::vector<Vec2> uv = {{0, 0},   {0.3, 0}, {0.6, 0},    {1, 0},     {1, 1},
+                          {0.5, 1}, {0, 1},   {0.45, 0.3}, {0.55, 0.7}};
   std::vector<std::array<int, 3>> triangles = triangulateFace(uv, 7, {{1, 5, {7, 8}}});
   double area = 0;
   std::vector<int> used(uv.size(), 0);

@@ -1,6 +1,4 @@
 // LimitSurface against values known in closed form.
-#include "render/subdiv/limit_surface.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +15,7 @@
 #include <thread>
 
 #include "render/core/error.h"
+#include "render/subdiv/limit_surface.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::subdiv {
@@ -24,10 +23,14 @@ namespace {
 
 double bsplineBasis(int k, double t) {
   switch (k) {
-    case 0: return (1 - t) * (1 - t) * (1 - t) / 6;
-    case 1: return (3 * t * t * t - 6 * t * t + 4) / 6;
-    case 2: return (-3 * t * t * t + 3 * t * t + 3 * t + 1) / 6;
-    default: return t * t * t / 6;
+    case 0:
+      return (1 - t) * (1 - t) * (1 - t) / 6;
+    case 1:
+      return (3 * t * t * t - 6 * t * t + 4) / 6;
+    case 2:
+      return (-3 * t * t * t + 3 * t * t + 3 * t + 1) / 6;
+    default:
+      return t * t * t / 6;
   }
 }
 
@@ -73,7 +76,8 @@ TEST(LimitSurface, LoopVertexLimitMatchesTheLimitMask) {
     for (int f = 0; f < m.faceCount(); ++f) {
       const int* fv = &m.faceVertexIndices[3 * f];
       if (fv[0] == vertex || fv[1] == vertex || fv[2] == vertex) {
-        for (int k = 0; k < 3; ++k) if (fv[k] != vertex) ring.insert(fv[k]);
+        for (int k = 0; k < 3; ++k)
+          if (fv[k] != vertex) ring.insert(fv[k]);
       }
     }
     ASSERT_EQ(static_cast<int>(ring.size()), n);
@@ -202,9 +206,8 @@ Agreement farAgainstBfr(const mesh::ControlMesh& m) {
       const LimitSample& want = expected[i];
       EXPECT_EQ(length(got.position - far.position(f, samples[i].x, samples[i].y)), 0.0);
       worst.position = std::max(worst.position, length(got.position - want.position) / diagonal);
-      worst.derivative = std::max(
-          {worst.derivative, length(got.du - want.du) / derivativeScale,
-           length(got.dv - want.dv) / derivativeScale});
+      worst.derivative = std::max({worst.derivative, length(got.du - want.du) / derivativeScale,
+                                   length(got.dv - want.dv) / derivativeScale});
       worst.normalDeg = std::max(worst.normalDeg, angleDeg(got.normal, want.normal));
     }
   }
@@ -255,8 +258,8 @@ TEST(LimitSurface, FarPatchesAgreeWithBfrWhereBothEvaluate) {
                              {"loop tetrahedron", testing::tetrahedron()}};
   for (const Case& c : cases) {
     Agreement a = farAgainstBfr(c.mesh);
-    std::printf("far-vs-bfr | %-30s | position %.2e | derivative %.2e | normal %.2e deg\n",
-                c.name, a.position, a.derivative, a.normalDeg);
+    std::printf("far-vs-bfr | %-30s | position %.2e | derivative %.2e | normal %.2e deg\n", c.name,
+                a.position, a.derivative, a.normalDeg);
     EXPECT_LE(a.position, 1e-6) << c.name;
     EXPECT_LE(a.derivative, 1e-6) << c.name;
     EXPECT_LE(a.normalDeg, 0.01) << c.name;
@@ -288,8 +291,8 @@ double worstEdgeGap(const LimitSurface& surface, int* edgesCompared) {
             double t = i / 16.0, a[2], b[2];
             surface.parameterization(f).GetEdgeCoord(k, t, a);
             surface.parameterization(g).GetEdgeCoord(j, 1 - t, b);
-            worst = std::max(worst, length(surface.position(f, a[0], a[1]) -
-                                           surface.position(g, b[0], b[1])));
+            worst = std::max(
+                worst, length(surface.position(f, a[0], a[1]) - surface.position(g, b[0], b[1])));
           }
         }
       }
@@ -323,8 +326,7 @@ void expectEvaluatesAroundValenceTwo(const mesh::ControlMesh& m, int expectedFar
   for (const Vec3& n : surface.controlLimitNormals()) EXPECT_NEAR(length(n), 1.0, 1e-9) << name;
   int edges = 0;
   double gap = worstEdgeGap(surface, &edges);
-  std::printf("val2-edges | %-24s | %d edges | worst gap %.2e of the diagonal\n", name, edges,
-              gap);
+  std::printf("val2-edges | %-24s | %d edges | worst gap %.2e of the diagonal\n", name, edges, gap);
   EXPECT_GT(edges, 0) << name;
   EXPECT_LE(gap, 1e-6) << name;
 }

@@ -89,7 +89,8 @@ TEST(Uniform, LoopMeshesStayTriangles) {
 // limit positions, normals within float precision (render/rules is tested shape by shape in
 // rules_test.cpp; this checks the assembly).
 TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
-  for (const mesh::ControlMesh& cage : {testing::cube(), testing::torus(), testing::icosahedron()}) {
+  for (const mesh::ControlMesh& cage :
+       {testing::cube(), testing::torus(), testing::icosahedron()}) {
     subdiv::LimitSurface surface(cage);
     UniformOptions options;
     options.level = 2;
@@ -100,8 +101,8 @@ TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
     EXPECT_EQ(tessellateUniform(surface, options).indices, tessellateCoarse(surface).indices);
     options.level = 2;
     for (UniformEngine engine : {UniformEngine::Masks, UniformEngine::Factored}) {
-      if (engine == UniformEngine::Factored && (cage.scheme == mesh::Scheme::Loop ||
-                                                !cage.creases.empty())) {
+      if (engine == UniformEngine::Factored &&
+          (cage.scheme == mesh::Scheme::Loop || !cage.creases.empty())) {
         continue;
       }
       options.engine = engine;
@@ -111,7 +112,8 @@ TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
       ASSERT_EQ(own.positions.size(), far.positions.size());
       for (size_t v = 0; v < far.positions.size(); ++v) {
         EXPECT_LT(length(own.positions[v].toDouble() - far.positions[v].toDouble()), 1e-6);
-        EXPECT_LT(length(own.limitPositions[v].toDouble() - far.limitPositions[v].toDouble()), 1e-6);
+        EXPECT_LT(length(own.limitPositions[v].toDouble() - far.limitPositions[v].toDouble()),
+                  1e-6);
         const Vec3 a = own.normals[v].toDouble(), b = far.normals[v].toDouble();
         EXPECT_LT(std::atan2(length(cross(a, b)), dot(a, b)) * 180 / M_PI, 0.01) << "vertex " << v;
       }
@@ -131,9 +133,10 @@ TEST(Uniform, PushToLimitMovesEveryVertexToItsLimit) {
       TriangleMesh pushed = tessellateUniform(surface, options);
       double before = 0;
       for (size_t v = 0; v < pushed.positions.size(); ++v) {
-        EXPECT_EQ(length(pushed.positions[v].toDouble() - pushed.limitPositions[v].toDouble()), 0.0);
-        before = std::max(before, length(refined.positions[v].toDouble() -
-                                         refined.limitPositions[v].toDouble()));
+        EXPECT_EQ(length(pushed.positions[v].toDouble() - pushed.limitPositions[v].toDouble()),
+                  0.0);
+        before = std::max(
+            before, length(refined.positions[v].toDouble() - refined.limitPositions[v].toDouble()));
       }
       EXPECT_GT(before, 1e-3) << "the refined vertices were already on the limit";
     }
@@ -180,7 +183,8 @@ TEST(Adaptive, VerticesLieOnTheLimitSurface) {
     for (int c = 0; c < 3; ++c) {
       Vec2f uv = mesh.cornerUVs[3 * t + c];
       Vec3 onSurface = surface.position(mesh.triangleFaces[t], uv.x, uv.y);
-      worst = std::max(worst, length(onSurface - mesh.positions[mesh.indices[3 * t + c]].toDouble()));
+      worst =
+          std::max(worst, length(onSurface - mesh.positions[mesh.indices[3 * t + c]].toDouble()));
     }
   }
   EXPECT_LT(worst, 1e-5);

@@ -23,8 +23,8 @@ inline void addFace(ControlMesh& m, std::initializer_list<int> vertices) {
 inline ControlMesh cube(Scheme scheme = Scheme::CatmullClark) {
   ControlMesh m;
   m.scheme = scheme;
-  m.points = {{-0.5, -0.5, 0.5}, {0.5, -0.5, 0.5},  {-0.5, 0.5, 0.5},  {0.5, 0.5, 0.5},
-              {-0.5, 0.5, -0.5}, {0.5, 0.5, -0.5},  {-0.5, -0.5, -0.5}, {0.5, -0.5, -0.5}};
+  m.points = {{-0.5, -0.5, 0.5}, {0.5, -0.5, 0.5}, {-0.5, 0.5, 0.5},   {0.5, 0.5, 0.5},
+              {-0.5, 0.5, -0.5}, {0.5, 0.5, -0.5}, {-0.5, -0.5, -0.5}, {0.5, -0.5, -0.5}};
   addFace(m, {0, 1, 3, 2});
   addFace(m, {2, 3, 5, 4});
   addFace(m, {4, 5, 7, 6});
@@ -64,8 +64,8 @@ inline ControlMesh icosahedron(Scheme scheme = Scheme::Loop) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   ControlMesh m;
   m.scheme = scheme;
-  m.points = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-              {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  m.points = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+              {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   const int faces[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -107,7 +107,8 @@ inline ControlMesh torus(int ring = 12, int tube = 8, bool creases = true) {
   }
   auto id = [&](int i, int j) { return (i % ring) * tube + (j % tube); };
   for (int i = 0; i < ring; ++i) {
-    for (int j = 0; j < tube; ++j) addFace(m, {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+    for (int j = 0; j < tube; ++j)
+      addFace(m, {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
   }
   if (creases) {
     for (int i = 0; i < ring; ++i) m.creases.push_back({id(i, 0), id(i + 1, 0), 10.0f});
@@ -115,7 +116,6 @@ inline ControlMesh torus(int ring = 12, int tube = 8, bool creases = true) {
   }
   return m;
 }
-
 
 // Merges coincident points (within 1e-9) and renumbers the faces: for meshes made of patches
 // whose shared borders were generated twice.
@@ -146,9 +146,10 @@ inline ControlMesh bumpyBall(int n = 16) {
   ControlMesh m;
   auto id = [n](int side, int i, int j) { return (side * (n + 1) + j) * (n + 1) + i; };
   // Each side: origin corner and two axes spanning it, wound outwards.
-  const Vec3 frames[6][3] = {{{-1, -1, 1}, {2, 0, 0}, {0, 2, 0}},  {{1, -1, -1}, {-2, 0, 0}, {0, 2, 0}},
-                             {{1, -1, 1}, {0, 0, -2}, {0, 2, 0}},  {{-1, -1, -1}, {0, 0, 2}, {0, 2, 0}},
-                             {{-1, 1, 1}, {2, 0, 0}, {0, 0, -2}},  {{-1, -1, -1}, {2, 0, 0}, {0, 0, 2}}};
+  const Vec3 frames[6][3] = {
+      {{-1, -1, 1}, {2, 0, 0}, {0, 2, 0}}, {{1, -1, -1}, {-2, 0, 0}, {0, 2, 0}},
+      {{1, -1, 1}, {0, 0, -2}, {0, 2, 0}}, {{-1, -1, -1}, {0, 0, 2}, {0, 2, 0}},
+      {{-1, 1, 1}, {2, 0, 0}, {0, 0, -2}}, {{-1, -1, -1}, {2, 0, 0}, {0, 0, 2}}};
   for (int side = 0; side < 6; ++side) {
     for (int j = 0; j <= n; ++j) {
       for (int i = 0; i <= n; ++i) {
@@ -164,7 +165,8 @@ inline ControlMesh bumpyBall(int n = 16) {
   for (int side = 0; side < 6; ++side) {
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
-        addFace(m, {id(side, i, j), id(side, i + 1, j), id(side, i + 1, j + 1), id(side, i, j + 1)});
+        addFace(m,
+                {id(side, i, j), id(side, i + 1, j), id(side, i + 1, j + 1), id(side, i, j + 1)});
       }
     }
   }
@@ -186,7 +188,8 @@ inline ControlMesh pawn(int around = 28) {
   for (int r = 1; r <= rings; ++r) {
     for (int k = 0; k < around; ++k) {
       double a = 2 * std::numbers::pi * k / around;
-      m.points.push_back({profile[r][0] * std::cos(a), profile[r][1], -profile[r][0] * std::sin(a)});
+      m.points.push_back(
+          {profile[r][0] * std::cos(a), profile[r][1], -profile[r][0] * std::sin(a)});
     }
   }
   const int top = static_cast<int>(m.points.size());
@@ -194,7 +197,8 @@ inline ControlMesh pawn(int around = 28) {
   auto id = [around](int r, int k) { return 1 + (r - 1) * around + (k % around); };
   for (int k = 0; k < around; ++k) addFace(m, {0, id(1, k + 1), id(1, k)});
   for (int r = 1; r < rings; ++r) {
-    for (int k = 0; k < around; ++k) addFace(m, {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
+    for (int k = 0; k < around; ++k)
+      addFace(m, {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
   }
   for (int k = 0; k < around; ++k) addFace(m, {id(rings, k), id(rings, k + 1), top});
   return m;

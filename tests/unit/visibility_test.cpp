@@ -4,6 +4,8 @@
 // its inner outline behind its near tube. The last two are checked against the reference's own
 // depth image (its primary rays), an independent path to the same answer, in perspective and
 // orthographic views.
+#include "render/oracle/visibility.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 
 #include "render/core/passes.h"
 #include "render/oracle/reference.h"
-#include "render/oracle/visibility.h"
 #include "render/silhouette/contour_polylines.h"
 #include "render/silhouette/presubdivide.h"
 #include "render/silhouette/silhouette_mesh.h"
@@ -71,7 +72,8 @@ Contours contours(const ControlMesh& control, const Camera& camera,
   out.visible = contourVisibility(surface, camera, queries, visibility, CancelToken(), &out.stats);
   if (offsetPx == 0) {  // the naive test aims at the point itself, wherever the curve put it
     for (VisibilityPoint& q : queries) q.slack = 0;
-    out.visible = contourVisibility(surface, camera, queries, visibility, CancelToken(), &out.stats);
+    out.visible =
+        contourVisibility(surface, camera, queries, visibility, CancelToken(), &out.stats);
   }
   return out;
 }
@@ -137,10 +139,11 @@ TEST(ContourVisibility, ConvexOutlineIsSeenWhole) {
       // The naive test (one ray aimed at the point itself, hits up to the point count) for
       // comparison: grazing rays touch the tessellation near the point.
       Contours naive = contours(testing::cube(), view, mode, steps, 0.0);
-      std::printf("convex outline, %s, searchSteps %d: %zu points, hidden: offset rays %zu, "
-                  "naive ray %zu\n",
-                  mode == silhouette::CurveMode::PN ? "pn" : "exact", steps, c.points.size(),
-                  countHidden(c.visible), countHidden(naive.visible));
+      std::printf(
+          "convex outline, %s, searchSteps %d: %zu points, hidden: offset rays %zu, "
+          "naive ray %zu\n",
+          mode == silhouette::CurveMode::PN ? "pn" : "exact", steps, c.points.size(),
+          countHidden(c.visible), countHidden(naive.visible));
     }
   }
 }
@@ -191,9 +194,8 @@ TEST(ContourVisibility, FarBlobIsHiddenWhereTheNearOneCoversIt) {
     coveredFar += covered;
     hiddenFar += !c.visible[i];
     if (margin < 1.0) continue;  // at the near outline itself either answer is right
-    EXPECT_EQ(c.visible[i], !covered)
-        << "far point at pixel (" << p.pixel.x << ", " << p.pixel.y << "), " << margin
-        << " px from the near outline";
+    EXPECT_EQ(c.visible[i], !covered) << "far point at pixel (" << p.pixel.x << ", " << p.pixel.y
+                                      << "), " << margin << " px from the near outline";
   }
   EXPECT_GT(coveredFar, 10u) << "the scene must put part of the far outline behind";
   EXPECT_GT(hiddenFar, 10u);
@@ -208,8 +210,8 @@ TEST(ContourVisibility, FarBlobIsHiddenWhereTheNearOneCoversIt) {
 TEST(ContourVisibility, OrthographicRaysRunAlongTheViewDirection) {
   // The same two blobs seen orthographically: the near one no longer looks larger, so move it
   // to cover part of the far one's outline.
-  Camera view({0, 0.2, 8}, {0, 0, 0}, {0, 1, 0}, 35, Projection::Orthographic, 3.0, 512, 512,
-              0.1, 100);
+  Camera view({0, 0.2, 8}, {0, 0, 0}, {0, 1, 0}, 35, Projection::Orthographic, 3.0, 512, 512, 0.1,
+              100);
   ControlMesh blobs = twoCubes({0.35, 0.1, 1.5}, {0, 0, -1.5});
   Contours c = contours(blobs, view);
   ASSERT_EQ(c.lines.size(), 2u);
@@ -244,11 +246,13 @@ TEST(ContourVisibility, NearlyEdgeOnTorusHidesPartOfItsInnerOutline) {
       expectAgreesWithReferenceDepth(testing::torus(24, 12, false), view, c, 0.1);
   EXPECT_GT(covered, 5u);
   EXPECT_GT(exposed, 100u);
-  Contours naive = contours(testing::torus(24, 12, false), view, silhouette::CurveMode::Exact, 5, 0);
-  std::printf("torus nearly edge-on: %zu polylines, %zu points, %zu hidden (%zu on the far "
-              "inner rim; naive ray: %zu); reference depth: %zu covered, %zu exposed\n",
-              c.lines.size(), c.points.size(), hidden, hiddenFarRim, countHidden(naive.visible),
-              covered, exposed);
+  Contours naive =
+      contours(testing::torus(24, 12, false), view, silhouette::CurveMode::Exact, 5, 0);
+  std::printf(
+      "torus nearly edge-on: %zu polylines, %zu points, %zu hidden (%zu on the far "
+      "inner rim; naive ray: %zu); reference depth: %zu covered, %zu exposed\n",
+      c.lines.size(), c.points.size(), hidden, hiddenFarRim, countHidden(naive.visible), covered,
+      exposed);
 }
 
 }  // namespace
