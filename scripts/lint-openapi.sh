@@ -5,10 +5,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 tools=build/tools
 version=2.77.0
+# The linter comes from the npm registry: a machine that cannot reach it skips the lint with a
+# warning rather than failing the build; a lint that runs and finds errors fails.
 if [ ! -x "$tools/node_modules/.bin/redocly" ]; then
-  command -v npm >/dev/null || { echo "lint-openapi: npm is not installed" >&2; exit 1; }
   mkdir -p "$tools"
-  npm install --prefix "$tools" --silent --no-audit --no-fund "@redocly/cli@$version" >/dev/null
+  if ! command -v npm >/dev/null ||
+     ! timeout 300 npm install --prefix "$tools" --silent --no-audit --no-fund \
+       "@redocly/cli@$version" >/dev/null 2>&1; then
+    echo "lint-openapi: WARNING: could not install @redocly/cli $version with npm; lint skipped" >&2
+    exit 0
+  fi
 fi
 set +e
 output=$("$tools/node_modules/.bin/redocly" lint api/openapi.json --format stylish 2>&1)
