@@ -72,56 +72,6 @@ struct PassImages {
   }
 };
 
-// Output pixels the outline of the tessellation may cross (see renderReference in reference.h):
-// the screen bounding boxes of every triangle whose geometric facing differs from the facing of
-// one of its vertex normals, or whose vertex normals disagree, and of every triangle of a face
-// on a border. The coverage of a triangle mesh changes only across an edge between a front- and
-// a back-facing triangle, or across a boundary edge, and at least one triangle at each such
-// edge is marked: so a thin spike or sliver between pixel centres is not missed.
-std::vector<char> outlineCandidates(const ReferenceTessellation& tessellation,
-                                    const Camera& camera) {
-  const tessellate::TriangleMesh& mesh = tessellation.mesh;
-  const int width = camera.width(), height = camera.height();
-  std::vector<char> marked(static_cast<size_t>(width) * height, 0);
-  auto toVec3 = [](const Vec3f& v) { return Vec3{v.x, v.y, v.z}; };
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, mesh.triangleCount(), 4096),
-      [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t < r.end(); ++t) {
-          const uint32_t* v = &mesh.indices[3 * t];
-          Vec3 p[3] = {toVec3(mesh.positions[v[0]]), toVec3(mesh.positions[v[1]]),
-                       toVec3(mesh.positions[v[2]])};
-          bool candidate = tessellation.borderFaces[mesh.triangleFaces[t]] != 0;
-          if (!candidate) {
-            Vec3 centroid = (p[0] + p[1] + p[2]) * (1.0 / 3.0);
-            bool facing = dot(cross(p[1] - p[0], p[2] - p[0]), camera.viewVector(centroid)) < 0;
-            for (int k = 0; k < 3 && !candidate; ++k) {
-              bool vertexFacing = dot(toVec3(mesh.normals[v[k]]), camera.viewVector(p[k])) < 0;
-              candidate = vertexFacing != facing;
-            }
-          }
-          if (!candidate) continue;
-          double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-          for (const Vec3& q : p) {
-            Vec3 s = camera.project(q);
-            x0 = std::min(x0, s.x), y0 = std::min(y0, s.y), x1 = std::max(x1, s.x),
-            y1 = std::max(y1, s.y);
-          }
-          int i0 = std::max(0, static_cast<int>(std::floor(x0))),
-              j0 = std::max(0, static_cast<int>(std::floor(y0)));
-          int i1 = std::min(width - 1, static_cast<int>(std::floor(x1))),
-              j1 = std::min(height - 1, static_cast<int>(std::floor(y1)));
-          for (int j = j0; j <= j1; ++j) {
-            for (int i = i0; i <= i1; ++i) {
-              std::atomic_ref<char>(marked[static_cast<size_t>(j) * width + i])
-                  .store(1, std::memory_order_relaxed);
-            }
-          }
-        }
-      });
-  return marked;
-}
-
 // Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
 // outline candidates, those with an 8-neighbour of other coverage, and those where the hint's
 // block is mixed or disagrees with the pixel.
@@ -221,17 +171,16 @@ void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
 }
 
 // The supersampled mask, S x S rays only in the pixels that need them (result.refinedPixels).
-void castSupersampledMask(const ReferenceTessellation& tessellation, RTCScene scene,
-                          const Camera& camera, const std::vector<PixelHit>& hits, int s,
-                          const Image* hint, const CancelToken& cancel, ReferenceResult& result) {
+void castSupersampledMask(const ReferenceScene& built, RTCScene scene, const Camera& camera,
+                          const std::vector<PixelHit>& hits, int s, const Image* hint,
+                          const CancelToken& cancel, ReferenceResult& result) {
   const int width = camera.width(), height = camera.height();
   std::vector<char> coverage(hits.size());
   for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
   if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
     hint = nullptr;
   }
-  result.refinedPixels =
-      pixelsToRefine(coverage, outlineCandidates(tessellation, camera), width, height, hint, s);
+  result.refinedPixels = pixelsToRefine(coverage, built.outlineCandidates, width, height, hint, s);
   size_t refined = 0;
   for (char r : result.refinedPixels) refined += r != 0;
   result.stats.refinedPixels = refined;
@@ -291,8 +240,8 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 
   if (passes.supersample > 0) {
     start = Clock::now();
-    castSupersampledMask(tessellation, scene, camera, hits, passes.supersample, options.maskHint,
-                         cancel, result);
+    castSupersampledMask(*built, scene, camera, hits, passes.supersample, options.maskHint, cancel,
+                         result);
     stats.maskMs = msSince(start);
     if (options.locateOutline) {
       start = Clock::now();

@@ -16,6 +16,7 @@
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
@@ -28,6 +29,9 @@ namespace limn::render::oracle {
 struct ReferenceScene {
   ReferenceTessellation tessellation;
   EmbreeScene scene;
+  // Per output pixel: the tessellation's outline may cross it (reference.cpp casts the
+  // supersampled mask there); a property of the mesh and the view, so cached with them.
+  std::vector<char> outlineCandidates;
   double tessellateMs = 0, bvhMs = 0;  // what building it cost
   size_t bytes = 0;                    // estimated memory: mesh arrays + Embree's BVH
 };

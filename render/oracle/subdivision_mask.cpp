@@ -178,39 +178,16 @@ float uniformLevel(const subdiv::LimitSurface& surface, const Camera& camera) {
   return static_cast<float>(std::clamp(std::ceil(level), 1.0, std::min(cap, double(kMaxLevel))));
 }
 
-// Casts eight rays `probe` pixels around pixel (x, y), along the axes and the diagonals; a crack
-// is a line, which passes through at most two opposite probes, so six or more hits make it a
-// crack, and the pixel covered (a hole wider than the probes gets none).
-void closeIfCrack(RTCScene scene, const Camera& camera, RTCIntersectContext& context, double probe,
-                  int x, int y, Image& mask) {
-  int hits = 0;
-  for (auto [dx, dy] :
-       {std::pair{-1, -1}, {1, -1}, {-1, 1}, {1, 1}, {-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
-    PixelRay r = pixelRay(camera, x + 0.5 + dx * probe, y + 0.5 + dy * probe);
-    Vec3 o = r.origin + r.direction * r.tNear;
-    RTCRay ray{static_cast<float>(o.x),
-               static_cast<float>(o.y),
-               static_cast<float>(o.z),
-               0.0f,
-               static_cast<float>(r.direction.x),
-               static_cast<float>(r.direction.y),
-               static_cast<float>(r.direction.z),
-               0.0f,
-               static_cast<float>(r.tFar - r.tNear),
-               0xFFFFFFFFu,
-               0,
-               0};
-    rtcOccluded1(scene, &context, &ray);
-    hits += ray.tfar < 0.0f;
-  }
-  if (hits >= 6) mask.at(x, y) = 1.0f;
-}
-
 // Embree's grids of neighbouring patches are evaluated separately and can leave cracks of zero
 // width between them, through which an occasional ray slips (measured: one pixel in 10^5 on an
-// open 3-face mesh). A missed pixel whose four neighbours are covered is cast again at four
-// points kCrackProbesPx around its centre: a hole in the surface has area, a crack does not.
-void closeCracks(RTCScene scene, const Camera& camera, Image& mask) {
+// open 3-face mesh). A missed pixel whose four neighbours are covered is cast again at eight
+// points kCrackProbesPx around its centre, along the axes and the diagonals: a crack is a line,
+// which passes through at most two opposite probes, so six or more hits make it a crack and the
+// pixel covered; a hole in the surface has area and gets none.
+void closeCracks(RTCScene scene, const Camera& camera, Image& mask, const CancelToken& cancel) {
+  constexpr int kProbes = 8, kHitsForACrack = 6;
+  constexpr int kDirections[kProbes][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1},
+                                           {-1, 0},  {1, 0},  {0, -1}, {0, 1}};
   const int w = mask.width, h = mask.height;
   std::vector<std::pair<int, int>> suspects;
   for (int y = 1; y + 1 < h; ++y) {
@@ -221,14 +198,26 @@ void closeCracks(RTCScene scene, const Camera& camera, Image& mask) {
       }
     }
   }
-  FlushDenormalsScope ftz;
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  for (auto [x, y] : suspects) {
-    for (double probe : kCrackProbesPx) {
-      if (mask.at(x, y) > 0) break;
-      closeIfCrack(scene, camera, context, probe, x, y, mask);
+  std::vector<Vec2> probes;
+  std::vector<char> covered;
+  for (double offset : kCrackProbesPx) {
+    probes.clear();
+    for (auto [x, y] : suspects) {
+      for (const auto& d : kDirections)
+        probes.push_back({x + 0.5 + d[0] * offset, y + 0.5 + d[1] * offset});
     }
+    castCoverageAt(scene, camera, probes, covered, cancel);
+    std::vector<std::pair<int, int>> stillOpen;
+    for (size_t k = 0; k < suspects.size(); ++k) {
+      int hits = 0;
+      for (int i = 0; i < kProbes; ++i) hits += covered[k * kProbes + i];
+      if (hits >= kHitsForACrack) {
+        mask.at(suspects[k].first, suspects[k].second) = 1.0f;
+      } else {
+        stillOpen.push_back(suspects[k]);
+      }
+    }
+    suspects = std::move(stillOpen);
   }
 }
 
@@ -324,7 +313,7 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
   }
   cancel.check();
   Image mask = castCoverage(scene.get(), camera, RayPacking::Packet16, cancel);
-  closeCracks(scene.get(), camera, mask);
+  closeCracks(scene.get(), camera, mask, cancel);
   if (outline) {
     // The outline's points are in output pixels; the rays go through the same points of the
     // supersampled camera.

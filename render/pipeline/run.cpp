@@ -147,19 +147,12 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   return selected;
 }
 
-// The independent check (Catmull-Clark): Embree's own subdivision geometry against the
-// reference's supersampled mask; the agreement goes into stats, a disagreement over a pixel or a
-// reason it could not run into the warnings.
+// The independent check: Embree's own subdivision geometry against the reference's mask and
+// outline; the agreement goes into stats, a disagreement over a pixel or the reason it could not
+// run (Loop, bilinear, rules Embree does not share) into the warnings.
 void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& camera, int S,
                          const oracle::ReferenceResult& reference, const CancelToken& cancel,
                          RenderResult& result) {
-  const Image& referenceMask = reference.images.supersampledMask;
-  if (surface.mesh().scheme != mesh::Scheme::CatmullClark) {
-    result.warnings.push_back(
-        "reference cross-check skipped: Embree's subdivision geometry is "
-        "Catmull-Clark only");
-    return;
-  }
   std::string whyNot;
   metrics::Outline embreeOutline;
   std::optional<Image> embreeMask =
@@ -168,7 +161,8 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
     result.warnings.push_back("reference cross-check skipped: " + whyNot);
     return;
   }
-  metrics::SilhouetteMetrics agreement = metrics::compareSilhouettes(*embreeMask, referenceMask, S);
+  metrics::SilhouetteMetrics agreement =
+      metrics::compareSilhouettes(*embreeMask, reference.images.supersampledMask, S);
   result.stats.referenceCrossCheckPx = agreement.hausdorffPx;
   result.stats.referenceCrossCheckMeanPx = agreement.meanPx;
   metrics::OutlineDistances outline = metrics::compareOutlines(
