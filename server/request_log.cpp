@@ -32,15 +32,6 @@ std::string safe(std::string_view text) {
 
 }  // namespace
 
-bool isLogLevel(std::string_view level) {
-  try {
-    levelOf(level);
-    return true;
-  } catch (const std::invalid_argument&) {
-    return false;
-  }
-}
-
 RequestLog::RequestLog(const std::string& level, std::shared_ptr<spdlog::sinks::sink> sink) {
   if (!sink) sink = std::make_shared<spdlog::sinks::stderr_sink_mt>();
   logger_ = std::make_shared<spdlog::logger>("limn.requests", std::move(sink));

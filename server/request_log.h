@@ -50,7 +50,4 @@ class RequestLog {
   std::atomic<uint64_t> nextId_{0};
 };
 
-// The level names RequestLog takes.
-bool isLogLevel(std::string_view level);
-
 }  // namespace limn::server

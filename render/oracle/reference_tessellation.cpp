@@ -129,6 +129,7 @@ ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface
   options.maxTriangles = 4 * static_cast<size_t>(kReferenceTriangleBudget);
   options.fitToBudget = true;
   options.stage = "reference";
+  options.remedy = "";
   options.ratesScaled = &result.ratesScaled;
   options.minSegments = [&segments](int edge) { return segments[edge]; };
   result.mesh = tessellate::tessellateAdaptive(surface, camera, options, cancel);

@@ -146,7 +146,7 @@ void keepToTriangleBudget(const subdiv::LimitSurface& surface, const AdaptiveOpt
           InputError::Kind::LimitExceeded, "maxTriangles",
           std::string(options.stage) + " tessellation would make " + std::to_string(triangles) +
               " triangles: exceeds limit maxTriangles " + std::to_string(options.maxTriangles) +
-              (std::string(options.stage) == "adaptive" ? " (raise params.dicingRate)" : ""));
+              (*options.remedy ? std::string(" (") + options.remedy + ")" : std::string()));
     }
     cancel.check();
     double factor = std::sqrt(static_cast<double>(options.maxTriangles) / triangles) * 0.95;

@@ -49,6 +49,7 @@ struct AdaptiveOptions {
   // factor in *ratesScaled.
   bool fitToBudget = false;
   const char* stage = "adaptive";
+  const char* remedy = "raise params.dicingRate";  // said in the 413; "" for none
   double* ratesScaled = nullptr;
   // Optional lower bound on the segments of base-level edge e (then capped by maxEdgeRate),
   // applied whether or not its faces are culled. Projected lengths are foreshortened where the

@@ -22,6 +22,7 @@
 #include "render/oracle/reference_scene.h"
 #include "render/oracle/reference_tessellation.h"
 #include "render/oracle/triangle_scene.h"
+#include "render/tessellate/tessellate.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::oracle {
@@ -468,6 +469,28 @@ TEST(Reference, OutlineOfTheReferenceTessellationMeshIsTheReferenceOutline) {
       locateMeshOutline(scene->tessellation.mesh, camera, r.images.supersampledMask, 4, {});
   metrics::OutlineDistances d = metrics::compareOutlines(o, r.outline, 1e9);
   EXPECT_LT(d.hausdorffPx, 2e-3);
+}
+
+// The pipeline locates the approximation's outline only in the pixels the reference refined
+// (it hinted the reference with the approximation's mask): that must find every crossing a
+// search of the whole mask finds. The approximation here is the coarse cage, far from the limit
+// surface, so its outline lies away from the reference's.
+TEST(Reference, RefinedPixelsHoldTheHintedApproximationsWholeOutline) {
+  for (const View& v : ownViews()) {
+    subdiv::LimitSurface surface(v.mesh);
+    Camera camera = cameraOf(surface, v, 96);
+    const int S = 4;
+    tessellate::TriangleMesh cage = tessellate::tessellateCoarse(surface);
+    EmbreeScene cageScene = buildTriangleScene(cage, RTC_BUILD_QUALITY_LOW);
+    Image cageMask = castCoverage(cageScene.get(), camera.scaled(S), RayPacking::Packet16, {});
+    ReferenceResult r = renderReference(surface, camera, PassSelection{.supersample = S}, {},
+                                        {.maskHint = &cageMask});
+    metrics::Outline everywhere = locateMeshOutline(cage, camera, cageMask, S, {});
+    metrics::Outline scanned = locateMeshOutline(cage, camera, cageMask, S, {}, &r.refinedPixels);
+    ASSERT_FALSE(everywhere.empty()) << v.name;
+    EXPECT_EQ(scanned.points.size(), everywhere.points.size()) << v.name;
+    EXPECT_EQ(metrics::compareOutlines(scanned, everywhere, 1e9).hausdorffPx, 0.0) << v.name;
+  }
 }
 
 TEST(ReferenceCache, SecondRequestForTheSameViewReusesTheScene) {
