@@ -11,12 +11,11 @@
 // reference cache (the same request again).
 #include <algorithm>
 #include <cstdio>
-#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "bench/bench_inputs.h"
+#include "bench/bench_common.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
 #include "tests/unit/test_meshes.h"
@@ -52,22 +51,6 @@ std::vector<NamedMesh> loadMeshes(const Config& config) {
     if (auto mesh = bench::readShape(config.corpus, shape)) meshes.push_back({shape, *mesh});
   }
   return meshes;
-}
-
-// Best of `repeat` runs after a warm-up; `beforeEach` runs before every one (e.g. to empty the
-// reference cache so that every run builds its scene).
-RenderResult runBest(
-    const RenderJob& job, render::pipeline::RenderContext& context, int repeat,
-    const std::function<void()>& beforeEach = [] {}) {
-  render::pipeline::JobLimits limits;
-  beforeEach();
-  RenderResult best = render::pipeline::run(job, limits, context, {});  // warm-up
-  for (int i = 0; i < repeat; ++i) {
-    beforeEach();
-    RenderResult r = render::pipeline::run(job, limits, context, {});
-    if (r.timings.totalMs < best.timings.totalMs) best = std::move(r);
-  }
-  return best;
 }
 
 RenderJob adaptiveJob(const NamedMesh& m, const Config& config) {
@@ -128,11 +111,11 @@ int main(int argc, char** argv) {
   for (const NamedMesh& m : loadMeshes(config)) {
     try {
       RenderJob job = adaptiveJob(m, config);
-      RenderResult plain = runBest(job, context, config.repeat);
+      RenderResult plain = bench::runBest(job, context, config.repeat);
       double adaptiveMs = plain.timings.approxMs + plain.timings.rasterMs;
       job.reference = true;
-      RenderResult r = runBest(job, context, config.repeat, [&] { cache.clear(); });
-      RenderResult hit = runBest(job, context, config.repeat);  // the scene stays cached
+      RenderResult r = bench::runBest(job, context, config.repeat, [&] { cache.clear(); });
+      RenderResult hit = bench::runBest(job, context, config.repeat);  // the scene stays cached
       const render::oracle::ReferenceStats& st = *r.timings.reference;
       std::printf(
           "| %s | %d | %.0f | %.0f | %.2f | %zu | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | "

@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "bench/bench_inputs.h"
+#include "bench/bench_common.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
 #include "tests/unit/test_meshes.h"
@@ -60,17 +60,6 @@ struct Variant {
   int level = 0;
 };
 
-render::pipeline::RenderResult runBest(const render::pipeline::RenderJob& job,
-                                       render::pipeline::RenderContext& context, int repeat) {
-  render::pipeline::JobLimits limits;
-  render::pipeline::RenderResult best = render::pipeline::run(job, limits, context, {});  // warm-up
-  for (int i = 0; i < repeat; ++i) {
-    render::pipeline::RenderResult r = render::pipeline::run(job, limits, context, {});
-    if (r.timings.totalMs < best.timings.totalMs) best = std::move(r);
-  }
-  return best;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -118,7 +107,7 @@ int main(int argc, char** argv) {
         job.params.level = v.level;
         job.outputs = {.color = true, .mask = true, .depth = true, .normal = true};
         try {
-          auto r = runBest(job, context, config.repeat);
+          auto r = bench::runBest(job, context, config.repeat);
           std::printf("| %s | %d | %d | %s | %zu | %.1f | %.1f | %.1f | %.1f |\n", m.name.c_str(),
                       m.mesh.faceCount(), size, v.label.c_str(), r.stats.triangles,
                       r.timings.surfaceMs, r.timings.approxMs, r.timings.rasterMs,
@@ -149,7 +138,7 @@ int main(int argc, char** argv) {
       job.reference = true;
       job.params.referenceCrossCheck = true;
       try {
-        auto r = runBest(job, context, std::max(1, config.repeat / 2));
+        auto r = bench::runBest(job, context, std::max(1, config.repeat / 2));
         std::string cross = r.stats.referenceCrossCheckPx
                                 ? std::to_string(*r.stats.referenceCrossCheckPx).substr(0, 5)
                                 : "n/a";

@@ -1,9 +1,11 @@
-// What the benchmark programs share: comma-separated flag values and corpus shapes read through
-// the real OBJ reader (scheme from the file name's prefix, as the corpus names them).
+// What the benchmark programs share: comma-separated flag values, corpus shapes read through
+// the real OBJ reader (scheme from the file name's prefix, as the corpus names them), and the
+// best of several warm runs of a job.
 #pragma once
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -11,6 +13,7 @@
 
 #include "api/obj_reader.h"
 #include "render/mesh/control_mesh.h"
+#include "render/pipeline/render_job.h"
 
 namespace limn::bench {
 
@@ -35,6 +38,22 @@ inline std::optional<render::mesh::ControlMesh> readShape(const std::filesystem:
   std::stringstream text;
   text << file.rdbuf();
   return api::readObj(text.str(), schemeOfShape(name), {}).mesh;
+}
+
+// The fastest (totalMs) of `repeat` runs after a warm-up; `beforeEach` runs before every one
+// (e.g. to empty the reference cache so that every run builds its scene).
+inline render::pipeline::RenderResult runBest(
+    const render::pipeline::RenderJob& job, render::pipeline::RenderContext& context, int repeat,
+    const std::function<void()>& beforeEach = [] {}) {
+  render::pipeline::JobLimits limits;
+  beforeEach();
+  render::pipeline::RenderResult best = render::pipeline::run(job, limits, context, {});
+  for (int i = 0; i < repeat; ++i) {
+    beforeEach();
+    render::pipeline::RenderResult r = render::pipeline::run(job, limits, context, {});
+    if (r.timings.totalMs < best.timings.totalMs) best = std::move(r);
+  }
+  return best;
 }
 
 }  // namespace limn::bench
