@@ -12,15 +12,22 @@
 
 namespace limn::api {
 
+// One stage of a job and the milliseconds it took ("surface", 12.5).
+struct StageTime {
+  std::string name;
+  double ms = 0;
+};
+
 // An HTTP-shaped answer with no socket attached: what the server writes back.
 struct Answer {
   int status = 200;
   std::string contentType = "application/json";
   std::string body;
   std::vector<std::pair<std::string, std::string>> headers;  // extra, e.g. Retry-After
-  // For the server's request log, not the client: the engine's stage times as a JSON object
-  // (renders), or "".
-  std::string logStages;
+  // For the server's request log and /metrics, not the client: the engine's stage times and
+  // the control mesh's face count (0 when no mesh was read).
+  std::vector<StageTime> stages;
+  size_t meshFaces = 0;
 };
 
 // A request the api layer refuses. `code` is one of DESIGN.md's error codes

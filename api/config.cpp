@@ -142,6 +142,7 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.integer("ioThreads", config.ioThreads, 1, 256);
   r.size("maxBodyBytes", config.maxBodyBytes, 1);
   r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);
+  r.integer("shutdownDrainMs", config.shutdownDrainMs, 0);
   r.size("referenceCacheBytes", config.referenceCacheBytes, 0);
   r.string("authToken", config.authToken);
   r.strings("corsOrigins", config.corsOrigins);

@@ -22,6 +22,9 @@ struct ServiceConfig {
   int ioThreads = 1;    // threads running the HTTP connections
   size_t maxBodyBytes = 64u << 20;
   int requestTimeoutMs = 120000;
+  // On SIGTERM: how long the requests already queued or running may take to finish before
+  // they are answered 503 and cancelled.
+  int shutdownDrainMs = 10000;
   // Reference tessellations + BVHs kept for further requests with the same mesh and camera.
   size_t referenceCacheBytes = 512u << 20;
   // Bearer token the /v1 routes require ("" = none); the environment variable LIMN_AUTH_TOKEN

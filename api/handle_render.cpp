@@ -1,7 +1,6 @@
 // handleRender: parse -> run -> write for POST /v1/render, with every failure turned into its
 // JSON error answer (answerOrError). The server and the CLI call it; it never throws.
 #include <chrono>
-#include <cstdio>
 
 #include "api/render_api.h"
 
@@ -9,14 +8,9 @@ namespace limn::api {
 
 namespace {
 
-std::string stageTimesJson(const render::pipeline::Timings& t) {
-  char text[256];
-  std::snprintf(text, sizeof text,
-                R"({"parseMs":%.3f,"surfaceMs":%.3f,"approxMs":%.3f,"rasterMs":%.3f,)"
-                R"("referenceMs":%.3f,"metricsMs":%.3f,"totalMs":%.3f})",
-                t.parseMs, t.surfaceMs, t.approxMs, t.rasterMs, t.referenceMs, t.metricsMs,
-                t.parseMs + t.totalMs);
-  return text;
+std::vector<StageTime> stageTimes(const render::pipeline::Timings& t) {
+  return {{"parse", t.parseMs},   {"surface", t.surfaceMs},     {"approx", t.approxMs},
+          {"raster", t.rasterMs}, {"reference", t.referenceMs}, {"metrics", t.metricsMs}};
 }
 
 }  // namespace
@@ -35,7 +29,8 @@ Answer handleRender(std::string_view body, const render::pipeline::JobLimits& li
 
     Answer answer;
     answer.body = writeRenderResponse(result, request);
-    answer.logStages = stageTimesJson(result.timings);
+    answer.stages = stageTimes(result.timings);
+    answer.meshFaces = static_cast<size_t>(result.stats.controlFaces);
     return answer;
   });
 }

@@ -26,6 +26,13 @@ Answer handleSilhouette(std::string_view body, std::string_view accept,
     } else {
       answer.body = writeSilhouetteJson(result, request);
     }
+    const render::pipeline::ContourTimings& t = result.timings;
+    answer.stages = {{"parse", t.parseMs},
+                     {"surface", t.surfaceMs},
+                     {"contour", t.contourMs},
+                     {"chain", t.chainMs},
+                     {"visibility", t.visibilityMs}};
+    answer.meshFaces = static_cast<size_t>(result.stats.controlFaces);
     return answer;
   });
 }

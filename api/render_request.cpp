@@ -62,8 +62,9 @@ render::CameraSpec parseCamera(const Value& camera, const JobLimits& limits,
   }
   if (const Value* v = json::find(camera, "fovYDeg")) {
     double fov = json::number(*v, "camera.fovYDeg");
-    if (!(fov > 0 && fov < 180)) {
-      json::fail("camera.fovYDeg", "camera.fovYDeg must be between 0 and 180 (exclusive)");
+    // Below a thousandth of a degree the projection's scale leaves float range.
+    if (!(fov >= 1e-3 && fov <= 179.9)) {
+      json::fail("camera.fovYDeg", "camera.fovYDeg must be between 0.001 and 179.9");
     }
     spec.fovYDeg = fov;
   }
@@ -297,7 +298,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
   if (!mesh) json::fail("mesh", "mesh is required");
   job.mesh = parseMesh(*mesh, limits, warnings);
 
-  request::checkViewDirection(job.camera, job.mesh);
+  request::checkCameraAgainstMesh(job.camera, job.mesh);
   return request;
 }
 
@@ -343,10 +344,33 @@ void parseSilhouetteParams(const Value& params, const JobLimits& limits,
   api::parseSilhouetteParams(params, limits, out);
 }
 
-void checkViewDirection(const render::CameraSpec& camera, const render::mesh::ControlMesh& mesh) {
+void checkCameraAgainstMesh(const render::CameraSpec& camera,
+                            const render::mesh::ControlMesh& mesh) {
+  const render::Bounds bounds = mesh.bounds();
+  const render::Vec3 centre = bounds.center();
+  // The rasteriser's float precision is relative to the mesh's size: a camera a million radii
+  // away (or an orthographic view a million times larger or smaller than the mesh) cannot be
+  // drawn meaningfully, and its tessellation estimates degenerate.
+  constexpr double kMaxScale = 1e6;
+  const double radius = std::max(bounds.diagonal() / 2, 1e-12);
+  auto checkDistance = [&](const std::optional<render::Vec3>& point, const char* field) {
+    if (point && render::length(*point - centre) > kMaxScale * radius) {
+      json::fail(field, std::string(field) + " is more than 1e6 bounding radii (" +
+                            json::formatNumber(radius) + ") from the mesh's centre");
+    }
+  };
+  checkDistance(camera.eye, "camera.eye");
+  checkDistance(camera.target, "camera.target");
+  if (camera.orthoHeight &&
+      !(*camera.orthoHeight <= kMaxScale * radius && *camera.orthoHeight >= radius / kMaxScale)) {
+    json::fail("camera.orthoHeight",
+               "camera.orthoHeight must be within 1e6 times the mesh's "
+               "bounding radius (" +
+                   json::formatNumber(radius) + ")");
+  }
   // The view needs a direction: an eye on the target (given, or the mesh's centre) has none.
   if (camera.eye) {
-    render::Vec3 target = camera.target.value_or(mesh.bounds().center());
+    render::Vec3 target = camera.target.value_or(centre);
     if (render::length(*camera.eye - target) == 0) {
       json::fail("camera.eye", "camera.eye is at the camera target: the view has no direction");
     }

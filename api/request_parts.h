@@ -41,7 +41,10 @@ void parseSilhouetteParams(const rapidjson::Value& params,
                            const render::pipeline::JobLimits& limits,
                            render::pipeline::MethodParams& out);
 
-// A 400 on camera.eye when the eye sits on the target (given, or the mesh's centre).
-void checkViewDirection(const render::CameraSpec& camera, const render::mesh::ControlMesh& mesh);
+// A 400 naming the camera field when the view cannot be drawn for this mesh: the eye on the
+// target (given, or the mesh's centre), an eye or target more than 1e6 bounding radii from the
+// mesh, an orthoHeight beyond 1e6 times the radius either way.
+void checkCameraAgainstMesh(const render::CameraSpec& camera,
+                            const render::mesh::ControlMesh& mesh);
 
 }  // namespace limn::api::request

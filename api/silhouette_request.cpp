@@ -96,7 +96,7 @@ SilhouetteRequest parseSilhouetteRequest(std::string_view body, std::string_view
     const Value* mesh = json::find(root, "mesh");
     if (!mesh) json::fail("mesh", "mesh is required");
     job.mesh = request::parseMesh(*mesh, limits, out.warnings);
-    request::checkViewDirection(job.camera, job.mesh);
+    request::checkCameraAgainstMesh(job.camera, job.mesh);
     return out;
   } catch (const render::InputError& error) {
     throw fromInputError(error);

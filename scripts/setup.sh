@@ -8,6 +8,9 @@ packages=(
   libembree-dev libosd-dev libopenimageio-dev openimageio-tools libboost-dev rapidjson-dev
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
   libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev curl
+  # the quality gates: clang with its sanitizer runtimes and libFuzzer (scripts/sanitize.sh,
+  # scripts/fuzz.sh), Prometheus' text-format parser for the /metrics test, load generators
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client wrk
 )
 
 missing=()

@@ -168,9 +168,9 @@ void Connection::answer(api::Answer answer, bool close) {
   response.prepare_payload();
 
   double seconds = std::chrono::duration<double>(Clock::now() - requestStart_).count();
-  shared_.router.stats().record(route_, answer.status, seconds);
+  shared_.router.metrics().answered(route_, answer.status, seconds);
   shared_.router.log().answered(
-      {id, method_, route_, answer.status, seconds, bytesIn_, bytesOut, answer.logStages});
+      {id, method_, route_, answer.status, seconds, bytesIn_, bytesOut, &answer.stages});
 
   armTimer(shared_.limits.writeTimeout);
   http::async_write(socket_, response,

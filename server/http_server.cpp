@@ -146,10 +146,17 @@ void HttpServer::run() {
     s.stopped.wait(lock, [&s] { return s.stopRequested; });
   }
 
-  // Renders first, so that every waiting connection gets its 503 to write; then the idle
-  // connections, which would otherwise wait for a next request that must not come.
-  s.pool.stop();
+  // Drain: no new connections (the acceptor is closed) and no new jobs (503), idle keep-alive
+  // connections closed, every answer from here on closes its connection; the jobs already
+  // queued or running get until the drain deadline to finish. Then what is left is answered
+  // 503 and cancelled, and the connections get a short grace to write their answers.
   s.shared.stopping = true;
+  for (const auto& connection : s.shared.registry.snapshot()) connection->closeIfIdle();
+  if (!s.pool.drain(std::chrono::steady_clock::now() + s.options.drainTimeout)) {
+    std::cerr << "limn: jobs still running after the " << s.options.drainTimeout.count()
+              << " ms drain; answering them 503 and cancelling them\n";
+  }
+  s.pool.stop();
   for (const auto& connection : s.shared.registry.snapshot()) connection->closeIfIdle();
   if (!s.shared.registry.waitUntilEmpty(s.options.shutdownGrace)) {
     std::cerr << "limn: some connections were still open after " << s.options.shutdownGrace.count()

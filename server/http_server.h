@@ -1,10 +1,11 @@
 // HttpServer: the network shell around the Router. It listens on host:port, runs Boost.Beast
 // connections on its own IO threads (render work runs on the WorkerPool's threads, never here),
 // and shuts down cleanly on SIGINT/SIGTERM:
-//   1. stop accepting;
-//   2. stop the pool: queued and running renders are answered 503 and cancelled;
-//   3. close idle keep-alive connections, let the others write their answers;
-//   4. return from run() once every connection is closed (or after a grace period).
+//   1. stop accepting, refuse new jobs with 503, close idle keep-alive connections;
+//   2. drain: queued and running jobs may finish until drainTimeout;
+//   3. stop the pool: what is still queued or running is answered 503 and cancelled;
+//   4. return from run() once every connection has written its answer and closed (or after
+//      shutdownGrace). The caller then joins the workers (WorkerPool::joinFor).
 // Beast lives only in the .cpp files, so including this header costs nothing.
 #pragma once
 
@@ -25,8 +26,9 @@ struct HttpOptions {
   int ioThreads = 1;
   size_t maxBodyBytes = 16 << 20;
   unsigned maxHeaderBytes = 16 << 10;
-  std::chrono::milliseconds readTimeout{30'000};  // to receive one request (slowloris guard)
-  std::chrono::milliseconds shutdownGrace{10'000};
+  std::chrono::milliseconds readTimeout{30'000};   // to receive one request (slowloris guard)
+  std::chrono::milliseconds drainTimeout{10'000};  // for the jobs in flight at a SIGTERM
+  std::chrono::milliseconds shutdownGrace{2'000};  // for connections to write their answers
 };
 
 class HttpServer {

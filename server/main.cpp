@@ -159,6 +159,8 @@ int serve(const CommandLine& cl) {
   poolOptions.timeout = std::chrono::milliseconds(config->requestTimeoutMs);
   render::oracle::ReferenceSceneCache referenceCache(config->referenceCacheBytes);
   poolOptions.referenceCache = &referenceCache;
+  server::ServiceMetrics metrics;
+  poolOptions.metrics = &metrics;
   server::WorkerPool pool(poolOptions);
   for (size_t i = 0; i < pool.workerStatus().size(); ++i) {
     const auto& w = pool.workerStatus()[i];
@@ -176,12 +178,13 @@ int serve(const CommandLine& cl) {
     if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token)
       access.authToken = token;
   }
-  server::Router router(config->limits, pool, access, config->logLevel);
+  server::Router router(config->limits, pool, metrics, access, config->logLevel);
   server::HttpOptions httpOptions;
   httpOptions.host = config->host;
   httpOptions.port = config->port;
   httpOptions.ioThreads = config->ioThreads;
   httpOptions.maxBodyBytes = config->maxBodyBytes;
+  httpOptions.drainTimeout = std::chrono::milliseconds(config->shutdownDrainMs);
   std::optional<server::HttpServer> http;
   try {
     http.emplace(httpOptions, router, pool);
@@ -194,7 +197,14 @@ int serve(const CommandLine& cl) {
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   std::cout << "limn listening on http://" << host << ":" << http->port() << std::endl;
   http->run();
-  pool.join();
+  // Every stage checks its cancel token well within a second; a worker that has not stopped
+  // after this is stuck, and must not keep the process alive (nor may its thread be joined).
+  constexpr std::chrono::milliseconds kStuckWorkerGrace{3'000};
+  if (!pool.joinFor(kStuckWorkerGrace)) {
+    std::cerr << "limn: a render worker did not stop within " << kStuckWorkerGrace.count()
+              << " ms of its cancellation; exiting without it\n";
+    std::_Exit(1);
+  }
   std::cerr << "limn: stopped\n";
   return 0;
 }

@@ -52,7 +52,15 @@ void RequestLog::answered(const AnsweredRequest& r) {
                 std::isfinite(r.seconds) ? r.seconds * 1000 : -1.0, r.bytesIn, r.bytesOut);
   std::string line = "\"id\":" + std::to_string(r.id) + ",\"method\":\"" + safe(r.method) +
                      "\",\"route\":\"" + safe(r.route) + "\"," + numbers;
-  if (!r.stagesJson.empty()) line += ",\"stages\":" + std::string(r.stagesJson);
+  if (r.stages && !r.stages->empty()) {
+    std::string stages;
+    for (const api::StageTime& stage : *r.stages) {
+      char ms[48];
+      std::snprintf(ms, sizeof ms, "%.3f", std::isfinite(stage.ms) ? stage.ms : -1.0);
+      stages += (stages.empty() ? "\"" : ",\"") + safe(stage.name) + "Ms\":" + ms;
+    }
+    line += ",\"stages\":{" + stages + "}";
+  }
   logger_->log(level, line);
 }
 

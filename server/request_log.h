@@ -5,9 +5,9 @@
 //    "status":200,"ms":12.3,"in":512,"out":20060,"stages":{"surfaceMs":0.4,...}}
 //
 // `id` numbers the requests of this process and is also sent back as X-Request-Id, so a client
-// can quote it; `stages` is the engine's timings for renders. Answers of 500 and over are logged
-// at level error, the rest at info; `logLevel` in the configuration ("debug", "info", "warn",
-// "error", "off") filters them. Thread-safe.
+// can quote it; `stages` is the engine's stage times (ms) for renders and contour searches. Answers
+// of 500 and over are logged at level error, the rest at info; `logLevel` in the configuration
+// ("debug", "info", "warn", "error", "off") filters them. Thread-safe.
 #pragma once
 
 #include <atomic>
@@ -15,6 +15,9 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "api/answer.h"
 
 namespace spdlog {
 class logger;
@@ -31,7 +34,7 @@ struct AnsweredRequest {
   int status = 0;
   double seconds = 0;
   size_t bytesIn = 0, bytesOut = 0;
-  std::string_view stagesJson;  // a JSON object, or "" for none
+  const std::vector<api::StageTime>* stages = nullptr;  // the engine's, for jobs; or none
 };
 
 class RequestLog {

@@ -61,20 +61,6 @@ std::string jsonString(std::string_view text) {
   return out + "\"";
 }
 
-// Prometheus label values escape backslash, quote and newline.
-std::string labelValue(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '\\' || c == '"') out += '\\';
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    out += c;
-  }
-  return out;
-}
-
 api::Answer jsonAnswer(int status, std::string body) {
   api::Answer answer;
   answer.status = status;
@@ -96,10 +82,11 @@ std::string Router::routeLabel(std::string_view target) {
   return "other";
 }
 
-Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, AccessOptions access,
-               const std::string& logLevel)
+Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, ServiceMetrics& metrics,
+               AccessOptions access, const std::string& logLevel)
     : limits_(limits),
       pool_(pool),
+      metrics_(metrics),
       access_(std::move(access)),
       log_(logLevel),
       started_(std::chrono::steady_clock::now()) {}
@@ -148,7 +135,7 @@ void Router::route(Request request, Reply reply) {
 
   if (path == "/healthz") return reply(healthz());
   if (path == "/readyz") return reply(readyz());
-  if (path == "/metrics") return reply(metrics());
+  if (path == "/metrics") return reply(metricsAnswer());
   if (path == "/openapi.json") return reply(jsonAnswer(200, std::string(api::openApiDocument())));
   if (path == "/v1/silhouette") {
     return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
@@ -220,28 +207,11 @@ api::Answer Router::readyz() const {
   return jsonAnswer(503, "{\"ready\":false,\"reason\":" + jsonString(reason) + "}");
 }
 
-api::Answer Router::metrics() const {
+api::Answer Router::metricsAnswer() const {
   PoolSnapshot pool = pool_.snapshot();
   std::ostringstream out;
-  out << "# HELP limn_requests_total HTTP requests answered, by route and status.\n"
-         "# TYPE limn_requests_total counter\n";
-  for (const auto& [key, count] : stats_.answers()) {
-    out << "limn_requests_total{path=\"" << labelValue(key.first) << "\",status=\"" << key.second
-        << "\"} " << count << "\n";
-  }
-  out << "# HELP limn_request_duration_seconds Time from a request's headers to its answer.\n"
-         "# TYPE limn_request_duration_seconds summary\n";
-  for (const auto& [route, d] : stats_.durations()) {
-    out << "limn_request_duration_seconds_sum{path=\"" << labelValue(route) << "\"} "
-        << d.secondsSum << "\n"
-        << "limn_request_duration_seconds_count{path=\"" << labelValue(route) << "\"} " << d.count
-        << "\n";
-  }
-  out << "# HELP limn_render_seconds Time workers spent running render jobs.\n"
-         "# TYPE limn_render_seconds summary\n"
-      << "limn_render_seconds_sum " << pool.renderSecondsSum << "\n"
-      << "limn_render_seconds_count " << pool.renderCount << "\n"
-      << "# HELP limn_queue_depth Render jobs waiting for a worker.\n"
+  out << metrics_.text();
+  out << "# HELP limn_queue_depth Render jobs waiting for a worker.\n"
          "# TYPE limn_queue_depth gauge\n"
       << "limn_queue_depth " << pool.queued << "\n"
       << "# HELP limn_queue_capacity Render jobs that may wait before requests get 429.\n"

@@ -22,7 +22,7 @@
 #include "render/pipeline/render_job.h"
 #include "server/access.h"
 #include "server/request_log.h"
-#include "server/request_stats.h"
+#include "server/service_metrics.h"
 #include "server/worker_pool.h"
 
 namespace limn::server {
@@ -40,8 +40,9 @@ class Router {
  public:
   using Reply = std::function<void(api::Answer)>;
 
-  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, AccessOptions access = {},
-         const std::string& logLevel = "info");
+  // `metrics` (shared with the pool, which records its jobs there) must outlive the router.
+  Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, ServiceMetrics& metrics,
+         AccessOptions access = {}, const std::string& logLevel = "info");
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
   // the pool's watchdog for renders.
@@ -51,13 +52,13 @@ class Router {
   static std::string routeLabel(std::string_view target);
 
   // The HTTP layer records every answer it writes here.
-  RequestStats& stats() { return stats_; }
+  ServiceMetrics& metrics() { return metrics_; }
   RequestLog& log() { return log_; }
 
  private:
   api::Answer healthz() const;
   api::Answer readyz() const;
-  api::Answer metrics() const;
+  api::Answer metricsAnswer() const;
   void render(std::string body, Reply reply);
   void silhouette(std::string body, std::string accept, Reply reply);
 
@@ -65,8 +66,8 @@ class Router {
 
   render::pipeline::JobLimits limits_;
   WorkerPool& pool_;
+  ServiceMetrics& metrics_;
   Access access_;
-  RequestStats stats_;
   RequestLog log_;
   std::chrono::steady_clock::time_point started_;
 };

@@ -14,11 +14,11 @@ using Clock = render::CancelToken::Clock;
 
 struct WorkerPool::Job {
   Job(Work w, Reply r, Clock::time_point due)
-      : work(std::move(w)), reply(std::move(r)), deadline(due), token(due) {}
+      : work(std::move(w)), reply(std::move(r)), queued(Clock::now()), deadline(due), token(due) {}
 
   Work work;
   Reply reply;
-  Clock::time_point deadline;
+  Clock::time_point queued, deadline;
   render::CancelToken token;
   bool settled = false;
   Deadlines::iterator deadlineEntry;
@@ -76,6 +76,9 @@ WorkerPool::WorkerPool(const PoolOptions& options) : options_(options) {
         startedCv.notify_all();
       }
       if (rasterizer) workerLoop(*rasterizer);
+      std::lock_guard lock(mutex_);
+      ++exitedWorkers_;
+      jobSettled_.notify_all();
     });
   }
   {
@@ -94,7 +97,7 @@ void WorkerPool::submit(Work work, Reply reply) {
   api::Answer refusal;
   {
     std::lock_guard lock(mutex_);
-    if (stopping_) {
+    if (stopping_ || draining_) {
       refusal = unavailableAnswer("the server is shutting down");
     } else if (readyWorkers_ == 0) {
       refusal = unavailableAnswer("no render worker has an OpenGL context: " +
@@ -157,6 +160,10 @@ void WorkerPool::workerLoop(render::raster::Rasterizer& rasterizer) {
       answer = api::errorAnswer({500, "internal", "render failed"});
     }
     double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (options_.metrics) {
+      options_.metrics->jobRan(std::chrono::duration<double>(start - job->queued).count(), seconds,
+                               answer);
+    }
 
     Reply reply;
     {
@@ -166,6 +173,7 @@ void WorkerPool::workerLoop(render::raster::Rasterizer& rasterizer) {
       renderSecondsSum_ += seconds;
       ++renderCount_;
       reply = claimLocked(*job);
+      jobSettled_.notify_all();
     }
     job->work = nullptr;  // frees the request body now rather than when the last owner lets go
     if (reply) reply(std::move(answer));
@@ -192,10 +200,25 @@ void WorkerPool::watchdogMain() {
     if (queued != queue_.end()) queue_.erase(queued);
     job->token.cancel();  // a running worker stops at its next check
     ++timedOut_;
+    jobSettled_.notify_all();
     lock.unlock();
     if (reply) reply(timeoutAnswer(options_.timeout));
     lock.lock();
   }
+}
+
+bool WorkerPool::drain(std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  draining_ = true;
+  // A job the watchdog answered 504 may still be running (cancelled): it has been answered.
+  auto answered = [this] {
+    if (!queue_.empty()) return false;
+    for (const auto& job : running_) {
+      if (!job->settled) return false;
+    }
+    return true;
+  };
+  return jobSettled_.wait_until(lock, deadline, answered);
 }
 
 void WorkerPool::stop() {
@@ -217,6 +240,18 @@ void WorkerPool::stop() {
   workAvailable_.notify_all();
   deadlinesChanged_.notify_all();
   for (auto& reply : replies) reply(unavailableAnswer("the server is shutting down"));
+}
+
+bool WorkerPool::joinFor(std::chrono::milliseconds timeout) {
+  {
+    std::unique_lock lock(mutex_);
+    const int threads = static_cast<int>(workers_.size());
+    if (!jobSettled_.wait_for(lock, timeout, [&] { return exitedWorkers_ == threads; })) {
+      return false;
+    }
+  }
+  join();
+  return true;
 }
 
 void WorkerPool::join() {
@@ -244,7 +279,6 @@ PoolSnapshot WorkerPool::snapshot() const {
   s.queued = queue_.size();
   s.queueCapacity = options_.queueDepth;
   s.stopping = stopping_;
-  s.renderSecondsSum = renderSecondsSum_;
   s.renderCount = renderCount_;
   s.rejectedBusy = rejectedBusy_;
   s.timedOut = timedOut_;

@@ -8,7 +8,9 @@
 //  - deadline: each job gets a CancelToken with deadline now + timeout; a watchdog thread
 //    answers 504 timeout the moment the deadline passes, whether the job is still queued
 //    (it leaves the queue) or running (its token is cancelled and the worker drops its result);
-//  - shutdown: stop() answers every queued and running job 503 and cancels the running ones.
+//  - shutdown: drain() refuses new jobs (503) and waits, up to a deadline, for the queued and
+//    running ones to finish; stop() answers every job still queued or running 503 and cancels
+//    the running ones; joinFor() waits a bounded time for the threads to end.
 // Whatever happens, a job's reply is called exactly once, from whichever thread settled it
 // (a worker, the watchdog, or the submitter for an immediate refusal).
 #pragma once
@@ -30,6 +32,7 @@
 #include "render/core/cancel.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
+#include "server/service_metrics.h"
 
 namespace limn::server {
 
@@ -39,6 +42,8 @@ struct PoolOptions {
   std::chrono::milliseconds timeout{60'000};  // per job, from submission
   // Shared by every worker's jobs (owned by the caller, outliving the pool); null: none.
   render::oracle::ReferenceSceneCache* referenceCache = nullptr;
+  // Where each job's queue wait, run time and stage times are recorded; null: nowhere.
+  ServiceMetrics* metrics = nullptr;
 };
 
 // What one worker thread reported when it tried to make its GL context.
@@ -56,8 +61,7 @@ struct PoolSnapshot {
   size_t queued = 0;
   size_t queueCapacity = 0;
   bool stopping = false;
-  double renderSecondsSum = 0;  // time workers spent inside jobs
-  size_t renderCount = 0;
+  size_t renderCount = 0;  // jobs run to their end
   size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
 };
 
@@ -77,10 +81,16 @@ class WorkerPool {
   // `work` must not throw (a throw becomes 500 internal anyway).
   void submit(Work work, Reply reply);
 
+  // Refuses new jobs (503) and waits until every queued and running job has been answered or
+  // `deadline` passed; true when none is left.
+  bool drain(std::chrono::steady_clock::time_point deadline);
   // Refuses new jobs, answers queued and running ones 503 and cancels the running ones.
   // Does not block; join() waits for the threads.
   void stop();
   void join();
+  // join() for at most `timeout` after stop(): false when a worker is still inside a job that
+  // has not noticed its cancellation (the threads are then left running, not joined).
+  bool joinFor(std::chrono::milliseconds timeout);
 
   // ---- Introspection ----
   PoolSnapshot snapshot() const;
@@ -109,10 +119,13 @@ class WorkerPool {
   mutable std::mutex mutex_;
   std::condition_variable workAvailable_;
   std::condition_variable deadlinesChanged_;
+  std::condition_variable jobSettled_;  // drain() and joinFor() wait on it
   std::deque<std::shared_ptr<Job>> queue_;
   std::unordered_set<std::shared_ptr<Job>> running_;
   Deadlines deadlines_;
   bool stopping_ = false;
+  bool draining_ = false;
+  int exitedWorkers_ = 0;
   int readyWorkers_ = 0;
   int busyWorkers_ = 0;
   double renderSecondsSum_ = 0;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <unordered_set>
 
@@ -76,9 +77,16 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
   if (mesh.faceCount() > limits.maxFaces) overLimit("maxFaces", mesh.faceCount(), limits.maxFaces);
 
   for (int v = 0; v < mesh.vertexCount(); ++v) {
-    if (!isFinite(mesh.points[v])) {
+    const Vec3& p = mesh.points[v];
+    if (!isFinite(p)) {
       invalid("vertex " + std::to_string(v),
               "vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+    if (std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z))) > kMaxCoordinate) {
+      char coordinates[96];
+      std::snprintf(coordinates, sizeof coordinates, "(%g, %g, %g)", p.x, p.y, p.z);
+      invalid("vertex " + std::to_string(v), "vertex " + std::to_string(v) + " at " + coordinates +
+                                                 " has a coordinate beyond +-1e15");
     }
   }
 

@@ -46,6 +46,10 @@ struct ControlMesh {
   Bounds bounds() const;
 };
 
+// The largest coordinate magnitude a mesh may have: the rasteriser works in float, and squared
+// distances of coordinates beyond this lose all precision (1e300 would overflow to infinity).
+inline constexpr double kMaxCoordinate = 1e15;
+
 struct MeshLimits {
   int maxVertices = 200000;
   int maxFaces = 200000;

@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -108,11 +110,49 @@ TEST_F(ServerTest, MetricsCountWhatWasAnswered) {
             std::string::npos)
       << r.body;
   EXPECT_NE(r.body.find("limn_requests_total{path=\"other\",status=\"404\"} "), std::string::npos);
-  EXPECT_NE(r.body.find("limn_request_duration_seconds_count{path=\"/v1/render\"} "),
+  EXPECT_NE(r.body.find("limn_request_duration_seconds_count{path=\"/v1/render\",status=\"200\"} "),
             std::string::npos);
   EXPECT_NE(r.body.find("\nlimn_queue_depth 0\n"), std::string::npos);
   EXPECT_NE(r.body.find("\nlimn_workers_busy "), std::string::npos);
   EXPECT_NE(r.body.find("\nlimn_render_seconds_count "), std::string::npos);
+}
+
+// What a Prometheus server scraping limn would read: the text goes through Prometheus' own
+// parser (Debian's python3-prometheus-client), and the histograms are there with samples.
+TEST_F(ServerTest, MetricsParseAsPrometheusTextWithHistograms) {
+  ASSERT_EQ(post(port(), "/v1/render", smallRender()).status, 200);
+  HttpResponse r = get(port(), "/metrics");
+  ASSERT_EQ(r.status, 200);
+  const std::string path = writeTempFile(r.body, ".prom");
+  const std::string command = "/usr/bin/python3 '" LIMN_SOURCE_DIR
+                              "/tests/integration/parse_metrics.py' '" +
+                              path + "' 2>&1";
+  std::string parsed;
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) parsed.append(buffer, n);
+  const int status = pclose(pipe);
+  std::remove(path.c_str());
+  ASSERT_EQ(status, 0) << parsed << "\n--- the text ---\n" << r.body;
+  // name -> (type, samples)
+  std::map<std::string, std::pair<std::string, int>> families;
+  std::istringstream lines(parsed);
+  for (std::string name, type; lines >> name >> type;) {
+    int samples = 0;
+    lines >> samples;
+    families[name] = {type, samples};
+  }
+  for (const char* histogram :
+       {"limn_request_duration_seconds", "limn_queue_wait_seconds", "limn_render_seconds",
+        "limn_render_stage_seconds", "limn_mesh_faces"}) {
+    ASSERT_TRUE(families.count(histogram)) << histogram << " missing:\n" << parsed;
+    EXPECT_EQ(families[histogram].first, "histogram") << histogram;
+    EXPECT_GT(families[histogram].second, 0) << histogram << " has no samples";
+  }
+  EXPECT_EQ(families["limn_queue_depth"].first, "gauge");
+  // Prometheus' parser drops _total from counter names.
+  EXPECT_EQ(families["limn_requests"].first, "counter") << parsed;
 }
 
 TEST_F(ServerTest, OpenApiDocumentDescribesRender) {
@@ -547,6 +587,51 @@ TEST(ServerShutdown, SigtermWhileARenderIsInFlightAnswersItAndExitsCleanly) {
   EXPECT_EQ(server.terminate(SIGTERM), 0);
   client.join();
   EXPECT_TRUE(status == 200 || status == 503) << "status " << status;
+}
+
+// SIGTERM under load (one worker, eight renders of about a second each): the connection
+// backlog is closed at once, every request already sent gets an answer - 200 for the ones
+// that finish within shutdownDrainMs, 503 for the rest - and the process exits soon after the
+// drain deadline.
+TEST(ServerShutdown, SigtermUnderLoadDrainsAnswersEveryoneAndExitsInBoundedTime) {
+  auto server =
+      ServerProcess::withConfig(R"({"workers": 1, "queueDepth": 16, "shutdownDrainMs": 1500})");
+  const int port = server.port();
+  constexpr int kClients = 8;
+  std::vector<int> statuses(kClients, 0);
+  std::vector<std::thread> clients;
+  for (int i = 0; i < kClients; ++i) {
+    clients.emplace_back([&, i] {
+      try {
+        statuses[i] = post(port, "/v1/render", slowRender()).status;
+      } catch (const std::exception&) {
+        statuses[i] = -1;  // connection dropped without an answer
+      }
+    });
+  }
+  for (int i = 0; i < 400; ++i) {
+    auto doc = parseJson(get(port, "/healthz").body);
+    if (doc["busyWorkers"].GetInt() > 0 && doc["queueDepth"].GetInt() >= kClients - 2) break;
+    std::this_thread::sleep_for(10ms);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  int exitStatus = -2;
+  std::thread terminating([&] { exitStatus = server.terminate(SIGTERM); });
+  std::this_thread::sleep_for(300ms);
+  EXPECT_THROW(HttpClient late(port), std::exception) << "new connections must be refused";
+  terminating.join();
+  const auto elapsed = std::chrono::steady_clock::now() - start;
+  for (auto& c : clients) c.join();
+  EXPECT_EQ(exitStatus, 0);
+  EXPECT_LT(elapsed, 4s) << "drain 1.5 s, then cancellation";
+  int finished = 0, refused = 0;
+  for (int status : statuses) {
+    EXPECT_TRUE(status == 200 || status == 503) << "status " << status;
+    finished += status == 200;
+    refused += status == 503;
+  }
+  EXPECT_GE(finished, 1) << "the render running at the signal fits the drain";
+  EXPECT_GE(refused, 1) << "eight seconds of renders cannot fit a 1.5 s drain";
 }
 
 TEST(ServerShutdown, SigintIsACleanShutdownToo) {

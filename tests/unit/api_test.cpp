@@ -386,9 +386,17 @@ TEST(ObjReader, BadCoordinatesNameTheLine) {
   EXPECT_DOUBLE_EQ(ok.mesh.points[0].x, 150.0);
   EXPECT_DOUBLE_EQ(ok.mesh.points[0].y, -0.5);
   EXPECT_DOUBLE_EQ(ok.mesh.points[0].z, 7.0);
-  // Beyond float range but finite in double.
-  api::ObjMesh big = api::readObj("v 1e300 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
-  EXPECT_DOUBLE_EQ(big.mesh.points[0].x, 1e300);
+  // Read in double precision (a float reader would keep 7 digits).
+  api::ObjMesh precise =
+      api::readObj("v 123456789.125 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
+  EXPECT_NEAR(precise.mesh.points[0].x, 123456789.125, 1e-6);  // float: off by 3
+  // Finite in double but beyond what limn renders (render::mesh::kMaxCoordinate): line named.
+  try {
+    api::readObj("v 1e300 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
+    ADD_FAILURE() << "1e300 was accepted";
+  } catch (const render::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 1"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ObjReader, GarbageAndBadTagsNameTheLine) {

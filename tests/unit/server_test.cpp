@@ -95,6 +95,17 @@ api::Answer ok(const char* body = "{}") {
   return a;
 }
 
+// A job that works for `duration` unless its token is cancelled first (it checks every ms).
+WorkerPool::Work sleepJob(std::chrono::milliseconds duration) {
+  return [duration](RenderContext&, const CancelToken& cancel) {
+    const auto until = std::chrono::steady_clock::now() + duration;
+    while (std::chrono::steady_clock::now() < until && !cancel.expired()) {
+      std::this_thread::sleep_for(1ms);
+    }
+    return ok();
+  };
+}
+
 // The request log writes one parseable JSON object per line, with the fields a log shipper
 // expects, errors at level error, and nothing below its level.
 TEST(RequestLog, OneJsonObjectPerAnsweredRequest) {
@@ -103,9 +114,9 @@ TEST(RequestLog, OneJsonObjectPerAnsweredRequest) {
   RequestLog log("info", sink);
   uint64_t first = log.nextId(), second = log.nextId();
   EXPECT_EQ(second, first + 1);
-  log.answered({first, "POST", "/v1/render", 200, 0.0123, 512, 20060,
-                R"({"surfaceMs":0.4,"rasterMs":5.0})"});
-  log.answered({second, "GET", "other", 503, 0.001, 0, 90, ""});
+  const std::vector<api::StageTime> stages = {{"surface", 0.4}, {"raster", 5.0}};
+  log.answered({first, "POST", "/v1/render", 200, 0.0123, 512, 20060, &stages});
+  log.answered({second, "GET", "other", 503, 0.001, 0, 90, nullptr});
   std::istringstream lines(text.str());
   std::vector<rapidjson::Document> docs;
   for (std::string line; std::getline(lines, line);) {
@@ -127,7 +138,7 @@ TEST(RequestLog, OneJsonObjectPerAnsweredRequest) {
 
   std::ostringstream quiet;
   RequestLog errorsOnly("error", std::make_shared<spdlog::sinks::ostream_sink_mt>(quiet));
-  errorsOnly.answered({1, "GET", "/healthz", 200, 0.001, 0, 10, ""});
+  errorsOnly.answered({1, "GET", "/healthz", 200, 0.001, 0, 10, nullptr});
   EXPECT_TRUE(quiet.str().empty());
   EXPECT_THROW(RequestLog("loud"), std::invalid_argument);
 }
@@ -286,7 +297,8 @@ api::Answer route(Router& router, const std::string& method, const std::string& 
 class RouterTest : public ::testing::Test {
  protected:
   WorkerPool pool{options(1, 2)};
-  Router router{render::pipeline::JobLimits{}, pool};
+  ServiceMetrics metrics;
+  Router router{render::pipeline::JobLimits{}, pool, metrics};
 };
 
 TEST_F(RouterTest, UnknownPathIs404Json) {
@@ -328,9 +340,9 @@ TEST_F(RouterTest, ReadyzFollowsThePool) {
 }
 
 TEST_F(RouterTest, MetricsCountAnswersByRouteAndStatus) {
-  router.stats().record(Router::routeLabel("/healthz"), 200, 0.5);
-  router.stats().record(Router::routeLabel("/healthz"), 200, 0.25);
-  router.stats().record(Router::routeLabel("/wp-admin.php"), 404, 0.001);
+  router.metrics().answered(Router::routeLabel("/healthz"), 200, 0.5);
+  router.metrics().answered(Router::routeLabel("/healthz"), 200, 0.25);
+  router.metrics().answered(Router::routeLabel("/wp-admin.php"), 404, 0.001);
   api::Answer answer = route(router, "GET", "/metrics");
   ASSERT_EQ(answer.status, 200);
   EXPECT_EQ(answer.contentType.rfind("text/plain", 0), 0u);
@@ -339,9 +351,20 @@ TEST_F(RouterTest, MetricsCountAnswersByRouteAndStatus) {
             std::string::npos)
       << text;
   EXPECT_NE(text.find("limn_requests_total{path=\"other\",status=\"404\"} 1\n"), std::string::npos);
-  EXPECT_NE(text.find("limn_request_duration_seconds_sum{path=\"/healthz\"} 0.75\n"),
+  // Cumulative buckets: 0.25 is in le="0.25" and above, 0.5 from le="0.5".
+  const std::string healthz = "path=\"/healthz\",status=\"200\"";
+  EXPECT_NE(text.find("limn_request_duration_seconds_bucket{" + healthz + ",le=\"0.1\"} 0\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("limn_request_duration_seconds_bucket{" + healthz + ",le=\"0.25\"} 1\n"),
             std::string::npos);
-  EXPECT_NE(text.find("limn_request_duration_seconds_count{path=\"/healthz\"} 2\n"),
+  EXPECT_NE(text.find("limn_request_duration_seconds_bucket{" + healthz + ",le=\"0.5\"} 2\n"),
+            std::string::npos);
+  EXPECT_NE(text.find("limn_request_duration_seconds_bucket{" + healthz + ",le=\"+Inf\"} 2\n"),
+            std::string::npos);
+  EXPECT_NE(text.find("limn_request_duration_seconds_sum{" + healthz + "} 0.75\n"),
+            std::string::npos);
+  EXPECT_NE(text.find("limn_request_duration_seconds_count{" + healthz + "} 2\n"),
             std::string::npos);
   EXPECT_NE(text.find("limn_queue_depth 0\n"), std::string::npos);
   EXPECT_NE(text.find("limn_workers_busy 0\n"), std::string::npos);
@@ -377,7 +400,8 @@ TEST_F(RouterTest, RenderRunsOnTheWorkerPool) {
 
 TEST(HttpServer, SlowRequestsGet408AndIdleConnectionsAreClosed) {
   WorkerPool pool(options(1, 2));
-  Router router(render::pipeline::JobLimits{}, pool);
+  ServiceMetrics metrics;
+  Router router(render::pipeline::JobLimits{}, pool, metrics);
   HttpOptions http;
   http.port = 0;
   http.readTimeout = 300ms;
@@ -395,6 +419,35 @@ TEST(HttpServer, SlowRequestsGet408AndIdleConnectionsAreClosed) {
     EXPECT_GE(std::chrono::steady_clock::now() - start, 250ms);
     EXPECT_TRUE(slow.peerClosed());
   }
+  // Trickled byte by byte, a header or a body still gets 408 at readTimeout from its start:
+  // the timer is not re-armed per byte, and no worker is held while it arrives.
+  for (std::string request :
+       {std::string("GET /healthz HTTP/1.1\r\nHost: x\r\nX-Slow: abcdefghijklmnopqrstuvwxyz"),
+        std::string("POST /v1/render HTTP/1.1\r\nHost: x\r\nContent-Length: 100\r\n\r\n") +
+            std::string(100, ' ')}) {
+    limn::testing::HttpClient slow(server.port());
+    const size_t body = request.find("\r\n\r\n");
+    const size_t trickleFrom = body == std::string::npos ? 20 : body + 4;
+    slow.send(request.substr(0, trickleFrom));
+    auto start = std::chrono::steady_clock::now();
+    std::atomic<bool> answered{false};
+    std::thread trickle([&] {
+      for (size_t i = trickleFrom; i < request.size() && !answered; ++i) {
+        try {
+          slow.send(request.substr(i, 1));
+        } catch (const std::exception&) {
+          return;  // closed by the server after its 408
+        }
+        EXPECT_EQ(pool.snapshot().busyWorkers, 0);
+        std::this_thread::sleep_for(20ms);
+      }
+    });
+    limn::testing::HttpResponse r = slow.readResponse();
+    answered = true;
+    trickle.join();
+    EXPECT_EQ(r.status, 408) << request.substr(0, 20);
+    EXPECT_LT(std::chrono::steady_clock::now() - start, 1500ms);
+  }
   {
     // A keep-alive connection that stays idle after its answer is closed without a word.
     limn::testing::HttpClient idle(server.port());
@@ -404,6 +457,48 @@ TEST(HttpServer, SlowRequestsGet408AndIdleConnectionsAreClosed) {
   }
   server.stop();
   serving.join();
+}
+
+// Shutdown drains: jobs already running finish within the drain time, new ones get 503, and
+// after the drain deadline what is left is answered 503 and cancelled.
+TEST(WorkerPool, DrainLetsRunningJobsFinishThenStopCancelsTheRest) {
+  WorkerPool pool(options(1, 4));
+  Captured quick, slow, late;
+  pool.submit(sleepJob(200ms), quick.reply());
+  std::this_thread::sleep_for(50ms);  // the quick job is running
+  pool.submit(sleepJob(10s), slow.reply());
+  auto start = std::chrono::steady_clock::now();
+  std::thread draining([&] { EXPECT_FALSE(pool.drain(start + 600ms)); });
+  std::this_thread::sleep_for(50ms);
+  pool.submit(sleepJob(1ms), late.reply());
+  EXPECT_EQ(late.wait(1s).status, 503) << "no new jobs while draining";
+  EXPECT_EQ(quick.wait(2s).status, 200) << "a job that fits the drain finishes";
+  draining.join();
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 550ms);
+  pool.stop();
+  EXPECT_EQ(slow.wait(2s).status, 503);
+  EXPECT_TRUE(pool.joinFor(2s)) << "the cancelled job stops at its next check";
+}
+
+// A job that never looks at its token cannot hold the process: joinFor() gives up.
+TEST(WorkerPool, JoinForGivesUpOnAWorkerThatIgnoresItsCancellation) {
+  auto pool = std::make_unique<WorkerPool>(options(1, 1));
+  std::atomic<bool> release{false};
+  Captured stuck;
+  pool->submit(
+      [&release](render::pipeline::RenderContext&, const render::CancelToken&) {
+        while (!release) std::this_thread::sleep_for(5ms);
+        return api::Answer{};
+      },
+      stuck.reply());
+  std::this_thread::sleep_for(50ms);
+  pool->stop();
+  EXPECT_EQ(stuck.wait(1s).status, 503);
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(pool->joinFor(300ms));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 1s);
+  release = true;  // let the thread end so that the test can join it
+  EXPECT_TRUE(pool->joinFor(2s));
 }
 
 }  // namespace

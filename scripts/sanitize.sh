@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The quality-gate build: every target compiled by clang with AddressSanitizer and
+# UndefinedBehaviorSanitizer (and libFuzzer's coverage instrumentation, so that the fuzz
+# targets come from the same tree) into build-sanitize/, then the quick test suite run in it.
+# Usage: scripts/sanitize.sh [ctest arguments...]   (default: -LE slow)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+jobs="${LIMN_JOBS:-$(nproc)}"
+# bench/ is left out: benchmarks under sanitizers measure nothing.
+modules="render/core;render/mesh;render/subdiv;render/normalmap;render/rules;render/tessellate"
+modules+=";render/silhouette;render/image;render/raster;render/metrics;render/oracle"
+modules+=";render/pipeline;api;server;tests/integration;fuzz"
+cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+  -DLIMN_SANITIZE=ON -DLIMN_FUZZ=ON "-DLIMN_MODULES=$modules" >/dev/null
+cmake --build build-sanitize -j "$jobs"
+
+# Leaks in the libraries limn loads (Mesa's llvmpipe, TBB's thread pool) are theirs, not ours.
+export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+[ $# -eq 0 ] && set -- -LE slow
+cd build-sanitize
+ctest --output-on-failure -j "${LIMN_TEST_JOBS:-1}" "$@"
