@@ -141,4 +141,16 @@ std::string writeTempFile(const std::string& contents, const std::string& suffix
   return name.data();
 }
 
+CommandResult runCommand(const std::string& commandLine) {
+  CommandResult result;
+  FILE* pipe = ::popen((commandLine + " 2>&1").c_str(), "r");
+  if (!pipe) throw std::runtime_error("popen failed: " + commandLine);
+  char buffer[4096];
+  for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+    result.output.append(buffer, n);
+  const int status = ::pclose(pipe);
+  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
 }  // namespace limn::testing

@@ -46,4 +46,11 @@ class ServerProcess {
 // A file in the temporary folder holding `contents`; the caller removes it.
 std::string writeTempFile(const std::string& contents, const std::string& suffix);
 
+// Runs a shell command line; its exit status and what it wrote (stdout and stderr together).
+struct CommandResult {
+  int status = -1;
+  std::string output;
+};
+CommandResult runCommand(const std::string& commandLine);
+
 }  // namespace limn::testing

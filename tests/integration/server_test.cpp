@@ -2,14 +2,17 @@
 // request, limits, concurrency, back-pressure, timeouts, keep-alive and a clean SIGTERM.
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -124,20 +127,13 @@ TEST_F(ServerTest, MetricsParseAsPrometheusTextWithHistograms) {
   HttpResponse r = get(port(), "/metrics");
   ASSERT_EQ(r.status, 200);
   const std::string path = writeTempFile(r.body, ".prom");
-  const std::string command = "/usr/bin/python3 '" LIMN_SOURCE_DIR
-                              "/tests/integration/parse_metrics.py' '" +
-                              path + "' 2>&1";
-  std::string parsed;
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  char buffer[4096];
-  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) parsed.append(buffer, n);
-  const int status = pclose(pipe);
+  CommandResult parsed = runCommand(
+      "/usr/bin/python3 '" LIMN_SOURCE_DIR "/tests/integration/parse_metrics.py' '" + path + "'");
   std::remove(path.c_str());
-  ASSERT_EQ(status, 0) << parsed << "\n--- the text ---\n" << r.body;
+  ASSERT_EQ(parsed.status, 0) << parsed.output << "\n--- the text ---\n" << r.body;
   // name -> (type, samples)
   std::map<std::string, std::pair<std::string, int>> families;
-  std::istringstream lines(parsed);
+  std::istringstream lines(parsed.output);
   for (std::string name, type; lines >> name >> type;) {
     int samples = 0;
     lines >> samples;
@@ -146,13 +142,13 @@ TEST_F(ServerTest, MetricsParseAsPrometheusTextWithHistograms) {
   for (const char* histogram :
        {"limn_request_duration_seconds", "limn_queue_wait_seconds", "limn_render_seconds",
         "limn_render_stage_seconds", "limn_mesh_faces"}) {
-    ASSERT_TRUE(families.count(histogram)) << histogram << " missing:\n" << parsed;
+    ASSERT_TRUE(families.count(histogram)) << histogram << " missing:\n" << parsed.output;
     EXPECT_EQ(families[histogram].first, "histogram") << histogram;
     EXPECT_GT(families[histogram].second, 0) << histogram << " has no samples";
   }
   EXPECT_EQ(families["limn_queue_depth"].first, "gauge");
   // Prometheus' parser drops _total from counter names.
-  EXPECT_EQ(families["limn_requests"].first, "counter") << parsed;
+  EXPECT_EQ(families["limn_requests"].first, "counter") << parsed.output;
 }
 
 TEST_F(ServerTest, OpenApiDocumentDescribesRender) {
@@ -162,6 +158,62 @@ TEST_F(ServerTest, OpenApiDocumentDescribesRender) {
   ASSERT_FALSE(doc.HasParseError());
   ASSERT_TRUE(doc.HasMember("paths"));
   EXPECT_TRUE(doc["paths"].HasMember("/v1/render"));
+}
+
+// The document against the server's real answers: every status and media type the server
+// sent is declared for its operation, and every JSON body validates against the declared
+// schema with no undocumented field (tests/integration/check_openapi.py, python3-jsonschema).
+TEST_F(ServerTest, RealAnswersMatchTheOpenApiDocument) {
+  struct Exchange {
+    const char* method;
+    const char* path;
+    std::string body;
+    Headers headers = {};
+  };
+  const std::string silhouetteStats =
+      renderBody("silhouette", 64, R"(, "outputs": ["color", "contours"], "reference": true)");
+  const std::vector<Exchange> exchanges = {
+      {"POST", "/v1/render",
+       renderBody("adaptive", 64,
+                  R"(, "outputs": ["color", "mask", "depth", "normal", "wireframe", "cage"],
+                     "reference": true, "params": {"referenceCrossCheck": true})")},
+      {"POST", "/v1/render", silhouetteStats},
+      {"POST", "/v1/render",
+       renderBody("uniform", 64, R"(, "params": {"level": 2}, "imageFormat": "exr")")},
+      {"POST", "/v1/render", renderBody("limit", 64, R"(, "outputs": ["color"], "extra": 1)")},
+      {"POST", "/v1/render", "{\"mesh\": "},
+      {"POST", "/v1/render", renderBody("uniform", 64, R"(, "params": {"level": 99})")},
+      {"POST", "/v1/render", R"({"mesh": {"format": "obj", "data": "v 0 0 0\nf 1 2 3\n"}})"},
+      {"GET", "/v1/render", ""},
+      {"POST", "/v1/silhouette", renderBody("silhouette", 64, "")},
+      {"POST", "/v1/silhouette", renderBody("silhouette", 64, ""), {{"Accept", "image/svg+xml"}}},
+      {"POST", "/v1/silhouette", R"({"mesh": 5})"},
+      {"GET", "/healthz", ""},
+      {"GET", "/readyz", ""},
+      {"GET", "/metrics", ""},
+      {"GET", "/openapi.json", ""},
+      {"POST", "/healthz", ""},
+  };
+  const std::string folder = writeTempFile("", "");
+  std::remove(folder.c_str());
+  ASSERT_EQ(::mkdir(folder.c_str(), 0700), 0);
+  std::set<int> statuses;
+  for (size_t i = 0; i < exchanges.size(); ++i) {
+    const Exchange& e = exchanges[i];
+    HttpResponse r = HttpClient(port()).request(e.method, e.path, e.body, e.headers);
+    statuses.insert(r.status);
+    const std::string name = folder + "/" + std::to_string(100 + i);
+    std::ofstream(name + ".meta") << e.method << " " << e.path << " " << r.status << " "
+                                  << r.header("Content-Type");
+    std::ofstream(name + ".body", std::ios::binary) << r.body;
+  }
+  CommandResult check =
+      runCommand("/usr/bin/python3 '" LIMN_SOURCE_DIR
+                 "/tests/integration/check_openapi.py' '" LIMN_SOURCE_DIR "/api/openapi.json' '" +
+                 folder + "'");
+  runCommand("rm -rf '" + folder + "'");
+  EXPECT_EQ(check.status, 0) << check.output;
+  EXPECT_EQ(statuses, (std::set<int>{200, 400, 405, 413, 422})) << "the exchanges cover these";
 }
 
 TEST_F(ServerTest, RenderOfACubeAnswersAPng) {
