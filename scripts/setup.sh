@@ -9,8 +9,9 @@ packages=(
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
   libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev curl
   # the quality gates: clang with its sanitizer runtimes and libFuzzer (scripts/sanitize.sh,
-  # scripts/fuzz.sh), Prometheus' text-format parser for the /metrics test, load generators
-  clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client wrk
+  # scripts/fuzz.sh), Prometheus' text-format parser and a JSON Schema validator (the /metrics and
+  # OpenAPI tests), the load generator
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
 )
 
 missing=()

@@ -5,22 +5,14 @@
 
 #include <memory>
 
+#include "render/subdiv/far_point.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::silhouette {
 
 namespace Far = OpenSubdiv::Far;
 
-namespace {
-
-// The primvar type Far's PrimvarRefiner interpolates.
-struct Point {
-  Vec3 p;
-  void Clear(void* = nullptr) { p = {0, 0, 0}; }
-  void AddWithWeight(const Point& o, float w) { p += o.p * static_cast<double>(w); }
-};
-
-}  // namespace
+namespace {}  // namespace
 
 bool hasSimpleFaces(const mesh::ControlMesh& mesh) {
   int want = mesh.scheme == mesh::Scheme::Loop ? 3 : 4;
@@ -60,11 +52,11 @@ mesh::ControlMesh refineOnce(const mesh::ControlMesh& mesh) {
   refiner->RefineUniform(options);
   const Far::TopologyLevel& fine = refiner->GetLevel(1);
 
-  std::vector<Point> coarsePoints(mesh.points.size());
+  std::vector<subdiv::FarPoint> coarsePoints(mesh.points.size());
   for (size_t i = 0; i < mesh.points.size(); ++i) coarsePoints[i].p = mesh.points[i];
-  std::vector<Point> finePoints(fine.GetNumVertices());
-  Point* src = coarsePoints.data();
-  Point* dst = finePoints.data();
+  std::vector<subdiv::FarPoint> finePoints(fine.GetNumVertices());
+  subdiv::FarPoint* src = coarsePoints.data();
+  subdiv::FarPoint* dst = finePoints.data();
   Far::PrimvarRefiner(*refiner).Interpolate(1, src, dst);
 
   mesh::ControlMesh out;
@@ -73,7 +65,7 @@ mesh::ControlMesh refineOnce(const mesh::ControlMesh& mesh) {
   out.creaseMethod = mesh.creaseMethod;
   out.triangleSubdivision = mesh.triangleSubdivision;
   out.points.reserve(finePoints.size());
-  for (const Point& p : finePoints) out.points.push_back(p.p);
+  for (const subdiv::FarPoint& p : finePoints) out.points.push_back(p.p);
   for (int f = 0; f < fine.GetNumFaces(); ++f) {
     Far::ConstIndexArray verts = fine.GetFaceVertices(f);
     out.faceVertexCounts.push_back(verts.size());

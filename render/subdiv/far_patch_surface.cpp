@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/subdiv/far_point.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::subdiv {
@@ -17,13 +18,6 @@ namespace Bfr = OpenSubdiv::Bfr;
 namespace Far = OpenSubdiv::Far;
 
 namespace {
-
-// The interface Far's PrimvarRefiner and stencil tables interpolate through.
-struct InterpolatedPoint {
-  Vec3 p{0, 0, 0};
-  void Clear(void* = nullptr) { p = {0, 0, 0}; }
-  void AddWithWeight(const InterpolatedPoint& src, double weight) { p += src.p * weight; }
-};
 
 // The most control points a patch has (a quad Gregory basis patch; Loop's are smaller).
 constexpr int kMaxPatchPoints = 20;
@@ -65,12 +59,12 @@ FarPatchSurface::FarPatchSurface(std::unique_ptr<Far::TopologyRefiner> refiner,
   // Patch point indices run over the control points, then every refined level, then the end
   // caps' local points.
   const int refinedTotal = refiner->GetNumVerticesTotal();
-  std::vector<InterpolatedPoint> buffer(refinedTotal + patches_->GetNumLocalPoints());
+  std::vector<FarPoint> buffer(refinedTotal + patches_->GetNumLocalPoints());
   for (size_t i = 0; i < points.size(); ++i) buffer[i].p = points[i];
   Far::PrimvarRefinerReal<double> primvars(*refiner);
-  InterpolatedPoint* src = buffer.data();
+  FarPoint* src = buffer.data();
   for (int level = 1; level <= refiner->GetMaxLevel(); ++level) {
-    InterpolatedPoint* dst = src + refiner->GetLevel(level - 1).GetNumVertices();
+    FarPoint* dst = src + refiner->GetLevel(level - 1).GetNumVertices();
     primvars.Interpolate(level, src, dst);
     src = dst;
   }
@@ -79,7 +73,7 @@ FarPatchSurface::FarPatchSurface(std::unique_ptr<Far::TopologyRefiner> refiner,
     endCaps->UpdateValues(buffer.data(), buffer.data() + refinedTotal);
   }
   patchPoints_.reserve(buffer.size());
-  for (const InterpolatedPoint& q : buffer) patchPoints_.push_back(q.p);
+  for (const FarPoint& q : buffer) patchPoints_.push_back(q.p);
 }
 
 FarPatchSurface::~FarPatchSurface() = default;

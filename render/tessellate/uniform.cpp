@@ -12,6 +12,7 @@
 #include "render/core/error.h"
 #include "render/rules/limit.h"
 #include "render/rules/refine.h"
+#include "render/subdiv/far_point.h"
 #include "render/tessellate/tessellate.h"
 
 namespace limn::render::tessellate {
@@ -19,18 +20,6 @@ namespace limn::render::tessellate {
 namespace Far = OpenSubdiv::Far;
 
 namespace {
-
-// The primvar type Far's PrimvarRefiner interpolates.
-struct Point {
-  double x = 0, y = 0, z = 0;
-  void Clear(void* = nullptr) { x = y = z = 0; }
-  void AddWithWeight(const Point& p, float w) {
-    x += w * p.x;
-    y += w * p.y;
-    z += w * p.z;
-  }
-  Vec3 vec() const { return {x, y, z}; }
-};
 
 // The last level of a refinement, whoever made it.
 struct Refined {
@@ -62,28 +51,28 @@ Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
   refiner->RefineUniform(options);
 
   // Interpolate positions through every level.
-  std::vector<Point> points(refiner->GetNumVerticesTotal());
+  std::vector<subdiv::FarPoint> points(refiner->GetNumVerticesTotal());
   const mesh::ControlMesh& cage = surface.mesh();
   for (int v = 0; v < cage.vertexCount(); ++v) {
-    points[v] = {cage.points[v].x, cage.points[v].y, cage.points[v].z};
+    points[v].p = cage.points[v];
   }
   Far::PrimvarRefiner primvar(*refiner);
-  Point* src = points.data();
+  subdiv::FarPoint* src = points.data();
   for (int l = 1; l <= level; ++l) {
-    Point* dst = src + refiner->GetLevel(l - 1).GetNumVertices();
+    subdiv::FarPoint* dst = src + refiner->GetLevel(l - 1).GetNumVertices();
     primvar.Interpolate(l, src, dst);
     src = dst;
   }
   const Far::TopologyLevel& last = refiner->GetLevel(level);
   const int vertexCount = last.GetNumVertices();
-  std::vector<Point> limit(vertexCount), du(vertexCount), dv(vertexCount);
+  std::vector<subdiv::FarPoint> limit(vertexCount), du(vertexCount), dv(vertexCount);
   primvar.Limit(src, limit, du, dv);
 
   Refined out;
   for (int v = 0; v < vertexCount; ++v) {
-    out.points.push_back(src[v].vec());
-    out.limit.push_back(limit[v].vec());
-    out.normals.push_back(cross(du[v].vec(), dv[v].vec()));
+    out.points.push_back(src[v].p);
+    out.limit.push_back(limit[v].p);
+    out.normals.push_back(cross(du[v].p, dv[v].p));
   }
   for (int f = 0; f < last.GetNumFaces(); ++f) {
     Far::ConstIndexArray fv = last.GetFaceVertices(f);

@@ -1,6 +1,8 @@
 // Accuracy through the real server: every method on the project's own meshes and on every
 // shape of ../shared/corpus/osd-shapes (skipped when that folder does not exist), measured
 // against the Embree reference exactly as a client would see it.
+#include "tests/support/corpus.h"
+
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
 #include <rapidjson/stringbuffer.h>
@@ -24,19 +26,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kCorpus = fs::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
+const fs::path kCorpus = corpusDir();
 
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+std::string readFile(const fs::path& path) { return readTextFile(path); }
 
+// The scheme's name in the request's mesh object.
 std::string schemeOf(const std::string& name) {
-  if (name.rfind("loop_", 0) == 0) return "loop";
-  if (name.rfind("bilinear_", 0) == 0) return "bilinear";
-  return "catmull-clark";
+  switch (corpusScheme(name)) {
+    case render::mesh::Scheme::Loop:
+      return "loop";
+    case render::mesh::Scheme::Bilinear:
+      return "bilinear";
+    default:
+      return "catmull-clark";
+  }
 }
 
 std::vector<std::string> corpusShapes() {

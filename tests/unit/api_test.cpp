@@ -17,6 +17,7 @@
 #include "api/openapi.h"
 #include "api/render_api.h"
 #include "render/raster/rasterizer.h"
+#include "tests/support/corpus.h"
 
 namespace {
 
@@ -92,22 +93,9 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-std::string readFile(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-fs::path corpusDir() {
-  return fs::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
-}
-
-Scheme schemeOfCorpusFile(const std::string& name) {
-  if (name.rfind("loop_", 0) == 0) return Scheme::Loop;
-  if (name.rfind("bilinear_", 0) == 0) return Scheme::Bilinear;
-  return Scheme::CatmullClark;
-}
+using limn::testing::corpusDir;
+std::string readFile(const fs::path& path) { return limn::testing::readTextFile(path); }
+Scheme schemeOfCorpusFile(const std::string& name) { return limn::testing::corpusScheme(name); }
 
 api::ObjMesh readCorpus(const std::string& name) {
   fs::path path = corpusDir() / (name + ".obj");

@@ -23,6 +23,7 @@
 #include "render/normalmap/normal_atlas.h"
 #include "render/raster/rasterizer.h"
 #include "render/tessellate/tessellate.h"
+#include "tests/support/corpus.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::normalmap {
@@ -34,44 +35,6 @@ using subdiv::LimitSurface;
 using tessellate::TriangleMesh;
 
 // ---- Helpers ----
-
-// The corpus's OBJ files: vertices, faces and holes (enough for what is tested here).
-std::optional<ControlMesh> readCorpus(const std::string& name) {
-  const auto path = std::filesystem::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" /
-                    "osd-shapes" / (name + ".obj");
-  std::ifstream in(path);
-  if (!in) return std::nullopt;
-  ControlMesh m;
-  if (name.rfind("loop_", 0) == 0) m.scheme = mesh::Scheme::Loop;
-  if (name.rfind("bilinear_", 0) == 0) m.scheme = mesh::Scheme::Bilinear;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string kind;
-    s >> kind;
-    if (kind == "v") {
-      Vec3 p;
-      s >> p.x >> p.y >> p.z;
-      m.points.push_back(p);
-    } else if (kind == "f") {
-      std::string token;
-      int count = 0;
-      while (s >> token) {
-        m.faceVertexIndices.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
-        ++count;
-      }
-      m.faceVertexCounts.push_back(count);
-    } else if (kind == "t") {
-      std::string tag, sizes;
-      s >> tag >> sizes;
-      int ints = 0;
-      std::sscanf(sizes.c_str(), "%d", &ints);
-      if (tag != "hole") continue;
-      for (int k = 0, f = 0; k < ints && s >> f; ++k) m.holes.push_back(f);
-    }
-  }
-  return m;
-}
 
 Vec3 texel(const Image& image, int x, int y) {
   return {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
@@ -126,7 +89,7 @@ std::vector<Shape> shapes() {
   };
   for (const char* name : {"catmark_nonquads", "catmark_hole_test1", "catmark_xord_interior",
                            "loop_xord_interior", "bilinear_cube", "catmark_edgenone"}) {
-    if (auto m = readCorpus(name)) out.push_back({name, *m});
+    if (auto m = testing::readCorpusShape(name)) out.push_back({name, *m});
   }
   return out;
 }
@@ -381,7 +344,8 @@ TEST(NormalAtlas, SubFaceCornersMeetAtEdgeMidpoints) {
   // mappedCage relies on it: sub-face k's (1, 0) is the midpoint of edge k and its (0, 1) that
   // of edge k - 1, so (1, 0) of sub-face k is (0, 1) of sub-face k + 1 on the surface.
   for (const ControlMesh& m :
-       {testing::octahedron(), readCorpus("catmark_nonquads").value_or(testing::octahedron())}) {
+       {testing::octahedron(),
+        testing::readCorpusShape("catmark_nonquads").value_or(testing::octahedron())}) {
     LimitSurface surface(m);
     for (int f = 0; f < surface.faceCount(); ++f) {
       const Parameterization p = surface.parameterization(f);

@@ -23,6 +23,7 @@
 #include "render/oracle/reference_tessellation.h"
 #include "render/oracle/triangle_scene.h"
 #include "render/tessellate/tessellate.h"
+#include "tests/support/corpus.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::oracle {
@@ -92,68 +93,7 @@ int faceWhere(const ControlMesh& m, int axis, double value) {
   return -1;
 }
 
-// ---- A minimal reader for the corpus's OBJ files (v, f and the t tags). ----
-
-std::optional<ControlMesh> readCorpusObj(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return std::nullopt;
-  ControlMesh m;
-  std::string name = path.filename().string();
-  if (name.rfind("loop_", 0) == 0) m.scheme = mesh::Scheme::Loop;
-  if (name.rfind("bilinear_", 0) == 0) m.scheme = mesh::Scheme::Bilinear;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string kind;
-    s >> kind;
-    if (kind == "v") {
-      Vec3 p;
-      s >> p.x >> p.y >> p.z;
-      m.points.push_back(p);
-    } else if (kind == "f") {
-      std::string token;
-      int count = 0;
-      while (s >> token) {
-        m.faceVertexIndices.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
-        ++count;
-      }
-      m.faceVertexCounts.push_back(count);
-    } else if (kind == "t") {
-      std::string tag, sizes;
-      s >> tag >> sizes;
-      int ni = 0, nf = 0, ns = 0;
-      std::sscanf(sizes.c_str(), "%d/%d/%d", &ni, &nf, &ns);
-      std::vector<int> ints(ni);
-      std::vector<float> floats(nf);
-      std::vector<std::string> strings(ns);
-      for (int& i : ints) s >> i;
-      for (float& f : floats) s >> f;
-      for (std::string& str : strings) s >> str;
-      if (tag == "crease") {
-        for (int k = 0; k + 1 < ni; k += 2) {
-          m.creases.push_back({ints[k], ints[k + 1], floats[nf == 1 ? 0 : k / 2]});
-        }
-      } else if (tag == "corner") {
-        for (int k = 0; k < ni; ++k) m.corners.push_back({ints[k], floats[nf == 1 ? 0 : k]});
-      } else if (tag == "hole") {
-        m.holes.insert(m.holes.end(), ints.begin(), ints.end());
-      } else if (tag == "interpolateboundary") {
-        m.boundary = ints[0] == 0   ? mesh::BoundaryInterpolation::None
-                     : ints[0] == 1 ? mesh::BoundaryInterpolation::EdgeAndCorner
-                                    : mesh::BoundaryInterpolation::EdgeOnly;
-      } else if (tag == "creasemethod" && !strings.empty() && strings[0] == "chaikin") {
-        m.creaseMethod = mesh::CreaseMethod::Chaikin;
-      } else if (tag == "smoothtriangles" && !strings.empty() && strings[0] == "smooth") {
-        m.triangleSubdivision = mesh::TriangleSubdivision::Smooth;
-      }
-    }
-  }
-  return m;
-}
-
-std::filesystem::path corpusDir() {
-  return std::filesystem::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
-}
+using testing::corpusDir;
 
 // ---- The reference at known points ----
 
@@ -708,11 +648,10 @@ TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     std::string name = entry.path().filename().string();
     if (name.rfind("catmark_", 0) != 0 || entry.path().extension() != ".obj") continue;
-    std::optional<ControlMesh> m = readCorpusObj(entry.path());
-    ASSERT_TRUE(m) << name;
+    std::optional<ControlMesh> m;
     std::unique_ptr<subdiv::LimitSurface> surface;
     try {
-      mesh::validateMesh(*m, mesh::MeshLimits{});
+      m = testing::readCorpusMesh(entry.path());
       surface = std::make_unique<subdiv::LimitSurface>(*m);
     } catch (const InputError& e) {
       continue;  // meshes OpenSubdiv refuses are the api's concern
@@ -753,11 +692,10 @@ TEST(Corpus, OutlineAgreesAcrossSupersampling) {
   int compared = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".obj") continue;
-    std::optional<ControlMesh> m = readCorpusObj(entry.path());
-    ASSERT_TRUE(m) << entry.path();
+    std::optional<ControlMesh> m;
     std::unique_ptr<subdiv::LimitSurface> surface;
     try {
-      mesh::validateMesh(*m, mesh::MeshLimits{});
+      m = testing::readCorpusMesh(entry.path());
       surface = std::make_unique<subdiv::LimitSurface>(*m);
     } catch (const InputError&) {
       continue;
@@ -844,7 +782,7 @@ void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, i
 TEST(OracleTiming, DISABLED_ThousandFacesAt1024) {
   timing::timeReference("torus 40 x 25", testing::torus(40, 25, false), {0.4, -1.2, 2.4}, 1024, 4);
   std::filesystem::path torus = corpusDir() / "catmark_torus.obj";
-  if (std::optional<ControlMesh> m = readCorpusObj(torus)) {
+  if (std::optional<ControlMesh> m = testing::readCorpusMesh(torus)) {
     subdiv::LimitSurface s(*m);
     timing::timeReference("corpus catmark_torus", *m, Vec3{0.3, 0.45, 0.85} * s.bounds().diagonal(),
                           1024, 4);

@@ -20,7 +20,9 @@
 #include "render/rules/limit.h"
 #include "render/rules/refine.h"
 #include "render/rules/weights.h"
+#include "render/subdiv/far_point.h"
 #include "render/subdiv/limit_surface.h"
+#include "tests/support/corpus.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::rules {
@@ -41,28 +43,16 @@ struct Shape {
   ControlMesh mesh;
 };
 
-fs::path corpusDir() {
-  return fs::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
-}
-
 ControlMesh readCorpus(const fs::path& path, Scheme scheme) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream text;
-  text << file.rdbuf();
-  return api::readObj(text.str(), scheme, {}).mesh;
+  return *testing::readCorpusMesh(path, scheme);
 }
 
 // Every catmark_ and loop_ shape of the corpus (bilinear_ ones are not subdivided by these
 // rules), variants that switch on the options the corpus leaves off, and own meshes.
 std::vector<Shape> allShapes() {
   std::vector<Shape> shapes;
-  if (fs::exists(corpusDir())) {
-    std::vector<fs::path> files;
-    for (const auto& entry : fs::directory_iterator(corpusDir())) {
-      if (entry.path().extension() == ".obj") files.push_back(entry.path());
-    }
-    std::sort(files.begin(), files.end());
-    for (const fs::path& path : files) {
+  if (!testing::corpusFiles().empty()) {
+    for (const fs::path& path : testing::corpusFiles()) {
       std::string name = path.stem().string();
       if (name.rfind("catmark_", 0) == 0)
         shapes.push_back({name, readCorpus(path, Scheme::CatmullClark)});
@@ -99,16 +89,7 @@ void PrintTo(const Shape& shape, std::ostream* out) { *out << shape.name; }
 
 // ---- OpenSubdiv, set up as render/subdiv/limit_surface.cpp sets it up ----
 
-struct FarPoint {
-  double x = 0, y = 0, z = 0;
-  void Clear(void* = nullptr) { x = y = z = 0; }
-  void AddWithWeight(const FarPoint& p, double w) {
-    x += w * p.x;
-    y += w * p.y;
-    z += w * p.z;
-  }
-  Vec3 vec() const { return {x, y, z}; }
-};
+using render::subdiv::FarPoint;
 
 // Far's uniform refinement to `levels`: the points of every level, in double precision.
 struct FarLevels {
@@ -123,7 +104,7 @@ FarLevels farRefine(const ControlMesh& m, int levels) {
   options.fullTopologyInLastLevel = true;
   out.refiner->RefineUniform(options);
   out.points.resize(levels + 1);
-  for (const Vec3& p : m.points) out.points[0].push_back({p.x, p.y, p.z});
+  for (const Vec3& p : m.points) out.points[0].push_back({p});
   Far::PrimvarRefinerReal<double> primvar(*out.refiner);
   for (int l = 1; l <= levels; ++l) {
     out.points[l].resize(out.refiner->GetLevel(l).GetNumVertices());
@@ -204,7 +185,7 @@ TEST_P(EveryShape, MasksRefineAsOpenSubdivVertexForVertex) {
     double worst = 0;
     int worstVertex = -1;
     for (int v = 0; v < farLevel.GetNumVertices(); ++v) {
-      double d = length(level->points[v] - far.points[l][v].vec());
+      double d = length(level->points[v] - far.points[l][v].p);
       if (!(d <= worst)) {
         worst = d;
         worstVertex = v;
@@ -234,12 +215,11 @@ TEST_P(EveryShape, LimitPositionsAndNormalsMatchOpenSubdiv) {
     const Topology& t = level->topology;
     ASSERT_EQ(mine.positions.size(), far.positions.size());
     for (int v = 0; v < t.vertexCount; ++v) {
-      const double gap = length(mine.positions[v] - far.positions[v].vec());
+      const double gap = length(mine.positions[v] - far.positions[v].p);
       worstPosition = std::max(worstPosition, gap);
       EXPECT_LE(gap, tolerance) << shape.name << " level " << l << " vertex " << v;
-      Vec3 farNormal = cross(far.tangent1[v].vec(), far.tangent2[v].vec());
-      if (length(farNormal) <=
-          1e-12 * length(far.tangent1[v].vec()) * length(far.tangent2[v].vec())) {
+      Vec3 farNormal = cross(far.tangent1[v].p, far.tangent2[v].p);
+      if (length(farNormal) <= 1e-12 * length(far.tangent1[v].p) * length(far.tangent2[v].p)) {
         ++degenerate;  // OpenSubdiv has no normal here (e.g. a corner between collinear edges)
         continue;
       }
@@ -402,7 +382,7 @@ size_t nearest(const std::vector<FarPoint>& points, const Vec3& p) {
   size_t best = 0;
   double bestDistance = 1e300;
   for (size_t i = 0; i < points.size(); ++i) {
-    double d = length(points[i].vec() - p);
+    double d = length(points[i].p - p);
     if (d < bestDistance) {
       bestDistance = d;
       best = i;
@@ -426,9 +406,9 @@ TEST_P(EveryShape, SubdividedControlMeshRefinesOnAsTheCage) {
   ASSERT_EQ(a.size(), b.size());
   std::vector<int> hits(b.size(), 0);
   for (size_t v = 0; v < a.size(); ++v) {
-    size_t match = nearest(b, a[v].vec());
+    size_t match = nearest(b, a[v].p);
     ++hits[match];
-    EXPECT_LE(length(a[v].vec() - b[match].vec()), 1e-9 * shape.mesh.bounds().diagonal())
+    EXPECT_LE(length(a[v].p - b[match].p), 1e-9 * shape.mesh.bounds().diagonal())
         << shape.name << " vertex " << v;
   }
   EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), static_cast<long>(b.size()))

@@ -16,6 +16,7 @@
 
 #include "render/core/error.h"
 #include "render/subdiv/limit_surface.h"
+#include "tests/support/corpus.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::subdiv {
@@ -369,35 +370,9 @@ TEST(LimitSurface, EvaluatesFacesAroundInteriorValenceTwoVertices) {
 // The corpus shape made for this case (skipped without ../shared/corpus): nine shapes with
 // interior valence-2 vertices next to creases, boundaries and n-gons.
 TEST(LimitSurface, EvaluatesTheCorpusValenceTwoShape) {
-  const auto path = std::filesystem::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" /
-                    "osd-shapes" / "catmark_val2_interior.obj";
-  std::ifstream in(path);
-  if (!in) GTEST_SKIP() << "no corpus at " << path;
-  mesh::ControlMesh m;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream words(line);
-    std::string kind;
-    words >> kind;
-    if (kind == "v") {
-      Vec3 p;
-      words >> p.x >> p.y >> p.z;
-      m.points.push_back(p);
-    } else if (kind == "f") {
-      int count = 0;
-      for (std::string token; words >> token; ++count) {
-        m.faceVertexIndices.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
-      }
-      m.faceVertexCounts.push_back(count);
-    } else if (kind == "t") {
-      std::string tag, sizes;
-      int v0, v1;
-      float sharpness;
-      words >> tag >> sizes;
-      if (tag == "crease" && words >> v0 >> v1 >> sharpness) {
-        m.creases.push_back({v0, v1, sharpness});
-      }
-    }
-  }
+  std::optional<mesh::ControlMesh> read = testing::readCorpusShape("catmark_val2_interior");
+  if (!read) GTEST_SKIP() << "no corpus at " << testing::corpusDir();
+  const mesh::ControlMesh& m = *read;
   ASSERT_EQ(m.faceCount(), 56);
   expectEvaluatesAroundValenceTwo(m, -1, "catmark_val2_interior");
   // The first shape's last two faces share vertex 16 (OBJ 17), interior with valence 2.
