@@ -115,6 +115,7 @@ void readLimits(const Value& object, const std::string& source,
   r.integer("maxValence", limits.mesh.maxValence, 3);
   r.integer("maxImageSide", limits.maxImageSide, 1);
   r.integer("maxSupersample", limits.maxSupersample, 1);
+  r.size("maxSupersampledPixels", limits.maxSupersampledPixels, 1);
   r.integer("maxLevel", limits.maxLevel, 0);
   r.number("minDicingRate", limits.minDicingRate, 0.0);
   r.integer("maxSearchSteps", limits.maxSearchSteps, 0);

@@ -127,8 +127,8 @@ Camera resolveCamera(const CameraSpec& spec, const Bounds& bounds) {
   Vec3 eye = spec.eye.value_or(target + Vec3{0, 0, distance});
   Vec3 up = spec.up.value_or(Vec3{0, 1, 0});
   double orthoHeight = spec.orthoHeight.value_or(radius * 2.1);
-  int width = spec.width.value_or(512);
-  int height = spec.height.value_or(512);
+  int width = spec.width.value_or(kDefaultImageSide);
+  int height = spec.height.value_or(kDefaultImageSide);
 
   // Near/far enclose the bounding sphere as seen along the view direction.
   Vec3 forward = normalize(target - eye);

@@ -77,6 +77,9 @@ class Camera {
   double tanHalfFov_;
 };
 
+// The image side a spec without width or height gets.
+inline constexpr int kDefaultImageSide = 512;
+
 // Fills what the spec leaves out: target = bounds centre, eye on +Z at a distance that frames
 // the bounding sphere, up = +Y, 35 degrees, perspective, 512 x 512; orthoHeight frames the
 // sphere. Near and far planes enclose the bounding sphere.

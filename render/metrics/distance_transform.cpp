@@ -29,7 +29,8 @@ ColumnDistances::ColumnDistances(int width, int height) : width_(width), height_
   distances_.reset(new uint16_t[static_cast<size_t>(width) * static_cast<size_t>(height)]);
 }
 
-void ColumnDistances::compute(const uint8_t* pixels, uint8_t featureBits) {
+void ColumnDistances::compute(const uint8_t* pixels, uint8_t featureBits,
+                              const CancelToken& cancel) {
   if (width_ == 0 || height_ == 0) return;
   // Rows are walked in order inside a stripe of columns, so memory is read forwards. A column
   // without features saturates at `height`: noFeature().
@@ -37,6 +38,7 @@ void ColumnDistances::compute(const uint8_t* pixels, uint8_t featureBits) {
   const uint16_t none = static_cast<uint16_t>(height_);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, w, kColumnStripe),
                     [&](const tbb::blocked_range<size_t>& stripe) {
+                      cancel.check();
                       const size_t x0 = stripe.begin(), x1 = stripe.end();
                       for (size_t x = x0; x < x1; ++x)
                         distances_[x] = (pixels[x] & featureBits) ? 0 : none;

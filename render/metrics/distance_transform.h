@@ -15,6 +15,8 @@
 #include <memory>
 #include <vector>
 
+#include "render/core/cancel.h"
+
 namespace limn::render::metrics {
 
 // Pass 1: per-column distance (in pixels) from each pixel to the nearest feature pixel of its
@@ -31,7 +33,9 @@ class ColumnDistances {
 
   // `pixels` is row-major, width x height bytes; a pixel is a feature when (byte & featureBits)
   // is non-zero, so one byte can carry flags for several feature sets.
-  void compute(const uint8_t* pixels, uint8_t featureBits);
+  // `cancel` is checked per stripe of columns.
+  void compute(const uint8_t* pixels, uint8_t featureBits,
+               const CancelToken& cancel = CancelToken{});
 
   int width() const { return width_; }
   int height() const { return height_; }

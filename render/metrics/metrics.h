@@ -3,6 +3,7 @@
 
 #include <optional>
 
+#include "render/core/cancel.h"
 #include "render/core/image.h"
 #include "render/subdiv/limit_surface.h"
 #include "render/tessellate/triangle_mesh.h"
@@ -44,9 +45,10 @@ struct Metrics {
 // covered where the value is above 0.5. When only one mask shows anything, hausdorffPx and
 // meanPx are the image diagonal in output pixels; when neither does, both are 0 and iou is 1.
 // Throws std::invalid_argument for masks of different sizes, not one channel, or a size that is
-// not a multiple of `supersample`.
-SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask,
-                                     int supersample);
+// not a multiple of `supersample`. `cancel` is checked every band of rows (32768^2 masks take
+// seconds), throwing Cancelled.
+SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask, int supersample,
+                                     const CancelToken& cancel = CancelToken{});
 // Coverage comes from each set's "mask" pass, else the colour's alpha (> 0.5), else depth > 0.
 // Missing or mismatched passes throw std::invalid_argument.
 //

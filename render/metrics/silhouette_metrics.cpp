@@ -61,7 +61,7 @@ void coverRow(const Image& a, const Image& b, int y, uint8_t* out) {
 // has its contour there. Tasks own whole bands of S rows (one output row each) and keep the
 // coverage of three rows in a ring, so each float is read about once and no thread reads
 // flags another writes.
-Classified classify(const Image& a, const Image& b, int s) {
+Classified classify(const Image& a, const Image& b, int s, const CancelToken& cancel) {
   const int width = a.width, height = a.height;
   const int outWidth = width / s, outHeight = height / s;
   const size_t w = static_cast<size_t>(width);
@@ -74,6 +74,7 @@ Classified classify(const Image& a, const Image& b, int s) {
   const int bandGrain = std::max(1, kRowGrain / s);
   tbb::parallel_for(
       tbb::blocked_range<int>(0, outHeight, bandGrain), [&](const tbb::blocked_range<int>& bands) {
+        cancel.check();
         std::vector<uint8_t> ring(3 * (w + 2), 0);  // one uncovered pixel either side of each row
         uint8_t* rows[3] = {ring.data() + 1, ring.data() + w + 3, ring.data() + 2 * w + 5};
         std::vector<int> countA(outWidth), countB(outWidth);
@@ -140,12 +141,13 @@ struct DirectedDistances {
 // pass of the other contour). Only rows holding `fromBit` pixels build their envelope; the
 // caller guarantees `to` has at least one feature.
 DirectedDistances directedDistances(const Classified& flags, uint8_t fromBit,
-                                    const ColumnDistances& to) {
+                                    const ColumnDistances& to, const CancelToken& cancel) {
   const int width = to.width(), height = to.height();
   std::vector<double> rowMax(height, 0.0), rowSum(height, 0.0);
   std::vector<long> rowCount(height, 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, height, kRowGrain),
                     [&](const tbb::blocked_range<int>& rows) {
+                      cancel.check();
                       RowEnvelope envelope;
                       for (int y = rows.begin(); y < rows.end(); ++y) {
                         if (!(flags.rowContours[y] & fromBit)) continue;
@@ -202,13 +204,13 @@ void checkMasks(const Image& mask, const Image& referenceMask, int supersample) 
 
 }  // namespace
 
-SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask,
-                                     int supersample) {
+SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask, int supersample,
+                                     const CancelToken& cancel) {
   checkMasks(mask, referenceMask, supersample);
   const int width = mask.width, height = mask.height;
   const double s = supersample;
 
-  const Classified flags = classify(mask, referenceMask, supersample);
+  const Classified flags = classify(mask, referenceMask, supersample, cancel);
   SilhouetteMetrics result;
   result.iou = flags.iou;
   result.mismatchPx = flags.mismatchPx;
@@ -227,10 +229,10 @@ SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMa
   }
 
   ColumnDistances columns(width, height);
-  columns.compute(flags.pixels.get(), kContourB);
-  const DirectedDistances aToB = directedDistances(flags, kContourA, columns);
-  columns.compute(flags.pixels.get(), kContourA);
-  const DirectedDistances bToA = directedDistances(flags, kContourB, columns);
+  columns.compute(flags.pixels.get(), kContourB, cancel);
+  const DirectedDistances aToB = directedDistances(flags, kContourA, columns, cancel);
+  columns.compute(flags.pixels.get(), kContourA, cancel);
+  const DirectedDistances bToA = directedDistances(flags, kContourB, columns, cancel);
   result.hausdorffPx = std::max(aToB.max, bToA.max) / s;
   result.meanPx = (aToB.sum + bToA.sum) / static_cast<double>(aToB.count + bToA.count) / s;
   return result;

@@ -19,6 +19,20 @@ void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& l
   }
 }
 
+void checkSupersampledMasks(const CameraSpec& camera, int supersample, const JobLimits& limits) {
+  const size_t samples = static_cast<size_t>(camera.width.value_or(kDefaultImageSide)) *
+                         static_cast<size_t>(camera.height.value_or(kDefaultImageSide)) *
+                         static_cast<size_t>(supersample) * static_cast<size_t>(supersample);
+  if (samples > limits.maxSupersampledPixels) {
+    throw InputError(InputError::Kind::LimitExceeded, "maxSupersampledPixels",
+                     "the silhouette metrics' masks at params.metricSupersample " +
+                         std::to_string(supersample) + " would have " + std::to_string(samples) +
+                         " samples each: exceeds limit maxSupersampledPixels (" +
+                         std::to_string(limits.maxSupersampledPixels) +
+                         "); lower metricSupersample or the image size");
+  }
+}
+
 void checkImageSides(const CameraSpec& camera, const JobLimits& limits) {
   for (const std::optional<int>& side : {camera.width, camera.height}) {
     if (side && (*side < 1 || *side > limits.maxImageSide)) {

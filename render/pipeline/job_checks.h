@@ -34,4 +34,8 @@ void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& l
 // camera.width and camera.height against maxImageSide (LimitExceeded).
 void checkImageSides(const CameraSpec& camera, const JobLimits& limits);
 
+// The supersampled masks of the silhouette metrics (width x height x S^2 floats each, two of
+// them) against maxSupersampledPixels (LimitExceeded), before any is allocated.
+void checkSupersampledMasks(const CameraSpec& camera, int supersample, const JobLimits& limits);
+
 }  // namespace limn::render::pipeline

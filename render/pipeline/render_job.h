@@ -58,6 +58,9 @@ struct JobLimits {
   mesh::MeshLimits mesh;
   int maxImageSide = 4096;
   int maxSupersample = 8;
+  // Samples of one supersampled metrics mask (width x height x S^2; 4 bytes each, two masks):
+  // 16384^2 by default, i.e. 4096^2 at S = 4 or 2048^2 at S = 8.
+  size_t maxSupersampledPixels = size_t{1} << 28;
   int maxLevel = 6;
   double minDicingRate = 0.25;
   int maxSearchSteps = 30;

@@ -48,6 +48,9 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
                  "must be in 1.." + std::to_string(limits.maxSupersample));
   }
   checkImageSides(job.camera, limits);
+  if (job.reference && job.method != Method::Limit) {
+    checkSupersampledMasks(job.camera, p.metricSupersample, limits);
+  }
 }
 
 // Normal-map shading: an atlas of the limit normals of `surface`'s faces, sized so the face
@@ -253,7 +256,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
                          .wireframe = job.outputs.wireframe,
                          .supersample = measure ? S : 0};
     if (context.rasterizer == nullptr) throw std::runtime_error("no rasterizer in this context");
-    result.images = context.rasterizer->render(*approx, camera, passes, job.shading, overlays);
+    result.images =
+        context.rasterizer->render(*approx, camera, passes, job.shading, overlays, cancel);
     result.timings.rasterMs = clock.lapMs();
     cancel.check();
   }
@@ -282,8 +286,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     if (measure) {
       const ImageSet& approxImages = result.images;
       const ImageSet& refImages = reference.images;
-      result.metrics.silhouette =
-          metrics::compareSilhouettes(approxImages.supersampledMask, refImages.supersampledMask, S);
+      result.metrics.silhouette = metrics::compareSilhouettes(
+          approxImages.supersampledMask, refImages.supersampledMask, S, cancel);
       // The reference was hinted with this mask: its refined pixels hold all of its outline.
       metrics::Outline outline = oracle::locateMeshOutline(
           *approx, camera, approxImages.supersampledMask, S, cancel, &reference.refinedPixels);

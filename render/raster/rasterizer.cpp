@@ -118,9 +118,11 @@ struct Rasterizer::Impl {
   Impl();
   ~Impl();
   void renderFrame(const Camera& camera, const PassSelection& passes, Shading shading,
-                   const std::vector<LineOverlay>& overlays, ImageSet& out);
+                   const std::vector<LineOverlay>& overlays, const CancelToken& cancel,
+                   ImageSet& out);
   void setLineUniforms(const Camera& camera);
-  void renderCoverage(const Camera& camera, int supersample, ImageSet& out);
+  void renderCoverage(const Camera& camera, int supersample, const CancelToken& cancel,
+                      ImageSet& out);
 };
 
 Rasterizer::Impl::Impl() {
@@ -169,7 +171,7 @@ void Rasterizer::Impl::setLineUniforms(const Camera& camera) {
 
 void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& passes,
                                    Shading shading, const std::vector<LineOverlay>& overlays,
-                                   ImageSet& out) {
+                                   const CancelToken& cancel, ImageSet& out) {
   const int width = camera.width(), height = camera.height();
   const bool colorBuffer = passes.color || passes.mask || passes.wireframe || !overlays.empty();
   Image color, mask, depth, normal, wireframe;
@@ -202,6 +204,7 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
   const float zero[4] = {0, 0, 0, 0};
 
   for (const Tile& tile : makeTiles(width, height, frameTileSize)) {
+    cancel.check();
     const Mat4 tileViewProjection =
         multiply(tileClipTransform(width, height, tile), viewProjection);
     frame.bind(tile.width, tile.height);
@@ -292,7 +295,8 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
   }
 }
 
-void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample, ImageSet& out) {
+void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample,
+                                      const CancelToken& cancel, ImageSet& out) {
   const Camera big = camera.scaled(supersample);
   const int width = big.width(), height = big.height();
   Image covered(width, height, 1);
@@ -304,6 +308,7 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample, Ima
   solidProgram.use();
   solidProgram.setVec4("uColor", one);
   for (const Tile& tile : makeTiles(width, height, coverageTileSize)) {
+    cancel.check();
     coverage.bind(tile.width, tile.height);
     coverage.setDrawBuffers({true});
     coverage.clearColor(0, zero);
@@ -327,7 +332,7 @@ const DeviceInfo& Rasterizer::device() const { return impl_->device; }
 
 ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& camera,
                             const PassSelection& passes, Shading shading,
-                            const std::vector<LineOverlay>& overlays) {
+                            const std::vector<LineOverlay>& overlays, const CancelToken& cancel) {
   if (camera.width() <= 0 || camera.height() <= 0) {
     throw std::invalid_argument("raster: the camera's image size must be positive");
   }
@@ -349,8 +354,8 @@ ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& 
   impl_->mesh.upload(mesh, mapped);
   if (mapped && frame) impl_->normalTexture.upload(*mesh.normalMap);
   if (!overlays.empty()) impl_->overlayLines.upload(overlays);
-  if (frame) impl_->renderFrame(camera, passes, shading, overlays, result);
-  if (passes.supersample > 0) impl_->renderCoverage(camera, passes.supersample, result);
+  if (frame) impl_->renderFrame(camera, passes, shading, overlays, cancel, result);
+  if (passes.supersample > 0) impl_->renderCoverage(camera, passes.supersample, cancel, result);
   return result;
 }
 

@@ -23,7 +23,7 @@ using Clock = std::chrono::steady_clock;
 // Small limits so that a request just over each of them is cheap to make and to refuse.
 constexpr const char* kConfig = R"({"workers": 2, "requestTimeoutMs": 10000,
   "limits": {"maxVertices": 2000, "maxFaces": 1000, "maxFaceSize": 64, "maxValence": 64,
-             "maxImageSide": 512, "maxSupersample": 4, "maxLevel": 4, "minDicingRate": 0.5,
+             "maxImageSide": 512, "maxSupersample": 4, "maxSupersampledPixels": 1048576, "maxLevel": 4, "minDicingRate": 0.5,
              "maxSearchSteps": 10, "maxCurveSamples": 64, "maxTriangles": 200000}})";
 
 const char* kCubePoints =
@@ -281,6 +281,10 @@ TEST_F(HostileInput, ARequestOverEachLimitIsRefusedNamingIt) {
       {"maxSupersample",
        cubeRequest("", R"(, "reference": true, "params": {"metricSupersample": 5})")},
       {"maxLevel", cubeRequest("", R"(, "method": "uniform", "params": {"level": 5})")},
+      // 512^2 at S = 4 is 4M mask samples; the limit is 1M (256^2 at S = 4 fits).
+      {"maxSupersampledPixels",
+       cubeRequest("", R"(, "reference": true, "params": {"metricSupersample": 4})", kCubePoints,
+                   R"({"width": 512, "height": 512})")},
       {"minDicingRate", cubeRequest("", R"(, "params": {"dicingRate": 0.25})")},
       {"maxSearchSteps",
        cubeRequest("", R"(, "method": "silhouette", "params": {"searchSteps": 11})")},

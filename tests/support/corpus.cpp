@@ -14,7 +14,9 @@ namespace limn::testing {
 
 namespace fs = std::filesystem;
 
-fs::path corpusDir() { return fs::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes"; }
+fs::path corpusDir() {
+  return fs::path(LIMN_SOURCE_DIR) / ".." / "shared" / "corpus" / "osd-shapes";
+}
 
 std::vector<fs::path> corpusFiles() {
   std::vector<fs::path> files;
