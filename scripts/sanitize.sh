@@ -19,9 +19,11 @@ cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Sanitize \
   -DLIMN_SANITIZE=ON -DLIMN_FUZZ=ON "-DLIMN_MODULES=$modules" >/dev/null
 cmake --build build-sanitize -j "$jobs"
 
-# Leaks in the libraries limn loads (Mesa's llvmpipe, TBB's thread pool) are theirs, not ours.
-export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
-export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1"
+# No LeakSanitizer here: Mesa's driver, loaded and unloaded by EGL in every test that draws,
+# leaves allocations whose stacks LSan can no longer attribute ("<unknown module>"), so no
+# suppression can name them. The fuzz targets (scripts/fuzz.sh), which never load Mesa, run
+# with leak detection on.
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:strict_string_checks=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 [ $# -eq 0 ] && set -- -LE slow
 cd build-sanitize

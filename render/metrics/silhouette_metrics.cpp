@@ -90,9 +90,12 @@ Classified classify(const Image& a, const Image& b, int s, const CancelToken& ca
             const uint8_t *up = rows[0], *here = rows[1], *down = rows[2];
             uint8_t* out = result.pixels.get() + static_cast<size_t>(y) * w;
             uint8_t rowAny = 0;
+            // The rows have one uncovered pixel either side: left[x] is here[x - 1] without
+            // an index that wraps below zero.
+            const uint8_t *left = here - 1, *right = here + 1;
             for (size_t x = 0; x < w; ++x) {
               // Bits set where all four neighbours are covered too.
-              const uint8_t inside = here[x] & up[x] & down[x] & here[x - 1] & here[x + 1];
+              const uint8_t inside = here[x] & up[x] & down[x] & left[x] & right[x];
               const uint8_t contour = static_cast<uint8_t>((here[x] & ~inside) << 2);
               out[x] = here[x] | contour;
               rowAny |= contour;
