@@ -145,6 +145,7 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);
   r.integer("shutdownDrainMs", config.shutdownDrainMs, 0);
   r.size("referenceCacheBytes", config.referenceCacheBytes, 0);
+  r.size("meshCacheBytes", config.meshCacheBytes, 0);
   r.string("authToken", config.authToken);
   r.strings("corsOrigins", config.corsOrigins);
   r.string("logLevel", config.logLevel);

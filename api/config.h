@@ -27,6 +27,8 @@ struct ServiceConfig {
   int shutdownDrainMs = 10000;
   // Reference tessellations + BVHs kept for further requests with the same mesh and camera.
   size_t referenceCacheBytes = 512u << 20;
+  // Meshes uploaded with POST /v1/meshes and referred to by id (least recently used go first).
+  size_t meshCacheBytes = 256u << 20;
   // Bearer token the /v1 routes require ("" = none); the environment variable LIMN_AUTH_TOKEN
   // sets it when the file does not (limn serve), so it need not be written to a file.
   std::string authToken;

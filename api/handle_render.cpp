@@ -16,11 +16,12 @@ std::vector<StageTime> stageTimes(const render::pipeline::Timings& t) {
 }  // namespace
 
 Answer handleRender(std::string_view body, const render::pipeline::JobLimits& limits,
-                    render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
+                    render::pipeline::RenderContext& context, const render::CancelToken& cancel,
+                    render::mesh::MeshCache* meshes) {
   return answerOrError("render", [&] {
     using Clock = std::chrono::steady_clock;
     const Clock::time_point start = Clock::now();
-    RenderRequest request = parseRenderRequest(body, limits);
+    RenderRequest request = parseRenderRequest(body, limits, meshes);
     const double parseMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 
     render::pipeline::RenderResult result =

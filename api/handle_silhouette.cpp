@@ -8,11 +8,11 @@ namespace limn::api {
 
 Answer handleSilhouette(std::string_view body, std::string_view accept,
                         const render::pipeline::JobLimits& limits,
-                        const render::CancelToken& cancel) {
+                        const render::CancelToken& cancel, render::mesh::MeshCache* meshes) {
   return answerOrError("contour search", [&] {
     using Clock = std::chrono::steady_clock;
     const Clock::time_point start = Clock::now();
-    SilhouetteRequest request = parseSilhouetteRequest(body, accept, limits);
+    SilhouetteRequest request = parseSilhouetteRequest(body, accept, limits, meshes);
     const double parseMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 
     render::pipeline::ContourResult result =

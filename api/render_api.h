@@ -10,6 +10,7 @@
 #include "api/answer.h"
 #include "render/core/cancel.h"
 #include "render/image/encode.h"
+#include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
 
 namespace limn::api {
@@ -25,7 +26,9 @@ struct RenderRequest {
 };
 
 // Throws ApiError (400 invalid_json / invalid_request, 413 too_large, 422 invalid_mesh).
-RenderRequest parseRenderRequest(std::string_view json, const render::pipeline::JobLimits& limits);
+// A "mesh": {"id": ...} is looked up in `meshes` (404 unknown_mesh when absent).
+RenderRequest parseRenderRequest(std::string_view json, const render::pipeline::JobLimits& limits,
+                                 render::mesh::MeshCache* meshes = nullptr);
 
 // The 200 answer's JSON: images (base64), reference.images, metrics, stats, timings, warnings,
 // camera. timings.totalMs = result.timings.parseMs + result.timings.totalMs (the engine's run)
@@ -36,6 +39,13 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
 // parse -> run -> write, with every failure turned into its JSON error answer (InputError ->
 // 4xx, Cancelled -> 504 timeout, anything else -> 500 internal). Never throws.
 Answer handleRender(std::string_view body, const render::pipeline::JobLimits& limits,
-                    render::pipeline::RenderContext& context, const render::CancelToken& cancel);
+                    render::pipeline::RenderContext& context, const render::CancelToken& cancel,
+                    render::mesh::MeshCache* meshes = nullptr);
+
+// POST /v1/meshes: {"mesh": {...}} (either form) is read, validated and kept in `meshes`;
+// answers {"id", "vertices", "faces", "scheme", "bytes", "warnings"}. A mesh larger than the
+// whole cache is a 413 naming meshCacheBytes. Never throws.
+Answer handleMeshUpload(std::string_view body, const render::pipeline::JobLimits& limits,
+                        render::mesh::MeshCache& meshes);
 
 }  // namespace limn::api

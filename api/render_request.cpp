@@ -12,6 +12,7 @@
 #include "api/obj_reader.h"
 #include "api/render_api.h"
 #include "api/request_parts.h"
+#include "render/mesh/mesh_cache.h"
 
 namespace limn::api {
 
@@ -47,14 +48,48 @@ int imageSide(const Value& value, const std::string& field, const JobLimits& lim
   return side;
 }
 
+render::Orbit parseOrbit(const Value& orbit, std::vector<std::string>& warnings) {
+  json::requireObject(orbit, "camera.orbit");
+  warnUnknownFields(orbit, "camera.orbit", {"azimuthDeg", "elevationDeg", "distance"}, warnings);
+  render::Orbit out;
+  if (const Value* v = json::find(orbit, "azimuthDeg")) {
+    out.azimuthDeg = json::number(*v, "camera.orbit.azimuthDeg");
+  }
+  if (const Value* v = json::find(orbit, "elevationDeg")) {
+    out.elevationDeg = json::number(*v, "camera.orbit.elevationDeg");
+    if (!(out.elevationDeg >= -90 && out.elevationDeg <= 90)) {
+      json::fail("camera.orbit.elevationDeg",
+                 "camera.orbit.elevationDeg must be between -90 and 90, got " +
+                     json::formatNumber(out.elevationDeg));
+    }
+  }
+  if (const Value* v = json::find(orbit, "distance")) {
+    out.distance = json::number(*v, "camera.orbit.distance");
+    if (!(*out.distance > 0)) {
+      json::fail("camera.orbit.distance",
+                 "camera.orbit.distance (in bounding-sphere radii) must be > 0, got " +
+                     json::formatNumber(*out.distance));
+    }
+  }
+  return out;
+}
+
 render::CameraSpec parseCamera(const Value& camera, const JobLimits& limits,
                                std::vector<std::string>& warnings) {
   json::requireObject(camera, "camera");
   warnUnknownFields(
       camera, "camera",
-      {"eye", "target", "up", "fovYDeg", "projection", "orthoHeight", "width", "height"}, warnings);
+      {"eye", "orbit", "target", "up", "fovYDeg", "projection", "orthoHeight", "width", "height"},
+      warnings);
   render::CameraSpec spec;
   if (const Value* v = json::find(camera, "eye")) spec.eye = json::vec3(*v, "camera.eye");
+  if (const Value* v = json::find(camera, "orbit")) {
+    if (spec.eye) {
+      json::fail("camera.orbit",
+                 "camera.orbit and camera.eye are two ways to place the eye; give one");
+    }
+    spec.orbit = parseOrbit(*v, warnings);
+  }
   if (const Value* v = json::find(camera, "target")) spec.target = json::vec3(*v, "camera.target");
   if (const Value* v = json::find(camera, "up")) {
     spec.up = json::vec3(*v, "camera.up");
@@ -200,7 +235,7 @@ render::pipeline::Outputs parseOutputs(const Value& value) {
   json::requireArray(value, "outputs");
   render::pipeline::Outputs out;
   out.color = false;
-  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours, Cage };
+  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours, Cage, Diff };
   for (rapidjson::SizeType i = 0; i < value.Size(); ++i) {
     Pass pass = json::choice<Pass>(value[i], "outputs[" + std::to_string(i) + "]",
                                    {{"color", Color},
@@ -209,17 +244,43 @@ render::pipeline::Outputs parseOutputs(const Value& value) {
                                     {"normal", Normal},
                                     {"wireframe", Wireframe},
                                     {"contours", Contours},
-                                    {"cage", Cage}});
+                                    {"cage", Cage},
+                                    {"diff", Diff}});
     bool* flags[] = {&out.color,     &out.mask,     &out.depth, &out.normal,
-                     &out.wireframe, &out.contours, &out.cage};
+                     &out.wireframe, &out.contours, &out.cage,  &out.diff};
     *flags[pass] = true;
   }
   return out;
 }
 
+// {"id": "..."}: a mesh uploaded before with POST /v1/meshes.
+render::mesh::ControlMesh storedMesh(const Value& mesh, render::mesh::MeshCache* meshes) {
+  for (auto it = mesh.MemberBegin(); it != mesh.MemberEnd(); ++it) {
+    std::string_view name(it->name.GetString(), it->name.GetStringLength());
+    if (name != "id") {
+      json::fail("mesh." + std::string(name),
+                 "mesh.id names an uploaded mesh, whose scheme and tags were fixed when it was "
+                 "uploaded; mesh." +
+                     std::string(name) + " cannot go with it (upload the changed mesh instead)");
+    }
+  }
+  std::string id(json::string(*json::find(mesh, "id"), "mesh.id"));
+  std::shared_ptr<const render::mesh::ControlMesh> found = meshes ? meshes->find(id) : nullptr;
+  if (!found) {
+    throw ApiError{404, "unknown_mesh",
+                   "mesh.id " + json::quote(id) +
+                       " is not a mesh this server holds (never uploaded, or evicted): upload it "
+                       "again with POST /v1/meshes",
+                   json::detailObject({{"field", "mesh.id"}, {"id", id}})};
+  }
+  return *found;
+}
+
 render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
-                                    std::vector<std::string>& warnings) {
+                                    std::vector<std::string>& warnings,
+                                    render::mesh::MeshCache* meshes) {
   json::requireObject(mesh, "mesh");
+  if (json::find(mesh, "id")) return storedMesh(mesh, meshes);
   std::string_view format = "json";
   if (const Value* v = json::find(mesh, "format")) format = json::string(*v, "mesh.format");
   if (format == "obj") {
@@ -251,7 +312,8 @@ render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
              "mesh.format must be one of \"obj\", \"json\"; got " + json::quote(format));
 }
 
-RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
+RenderRequest parseDocument(const Value& root, const JobLimits& limits,
+                            render::mesh::MeshCache* meshes) {
   if (!root.IsObject()) {
     json::fail("", "the request body must be a JSON object, got " + json::describe(root));
   }
@@ -288,6 +350,11 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
   }
   if (const Value* v = json::find(root, "reference"))
     job.reference = json::boolean(*v, "reference");
+  if (job.outputs.diff && (!job.reference || job.method == Method::Limit)) {
+    json::fail("outputs",
+               "output \"diff\" compares the method's colour with the reference: it needs "
+               "\"reference\": true and a method other than \"limit\"");
+  }
   if (const Value* v = json::find(root, "imageFormat")) {
     request.imageFormat = json::choice<render::image::Format>(
         *v, "imageFormat",
@@ -296,7 +363,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits) {
 
   const Value* mesh = json::find(root, "mesh");
   if (!mesh) json::fail("mesh", "mesh is required");
-  job.mesh = parseMesh(*mesh, limits, warnings);
+  job.mesh = parseMesh(*mesh, limits, warnings, meshes);
 
   request::checkCameraAgainstMesh(job.camera, job.mesh);
   return request;
@@ -335,8 +402,9 @@ render::CameraSpec parseCamera(const Value& camera, const JobLimits& limits,
 }
 
 render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
-                                    std::vector<std::string>& warnings) {
-  return api::parseMesh(mesh, limits, warnings);
+                                    std::vector<std::string>& warnings,
+                                    render::mesh::MeshCache* meshes) {
+  return api::parseMesh(mesh, limits, warnings, meshes);
 }
 
 void parseSilhouetteParams(const Value& params, const JobLimits& limits,
@@ -361,6 +429,10 @@ void checkCameraAgainstMesh(const render::CameraSpec& camera,
   };
   checkDistance(camera.eye, "camera.eye");
   checkDistance(camera.target, "camera.target");
+  if (camera.orbit && camera.orbit->distance && *camera.orbit->distance > kMaxScale) {
+    json::fail("camera.orbit.distance",
+               "camera.orbit.distance is more than 1e6 bounding radii (it is in radii)");
+  }
   if (camera.orthoHeight &&
       !(*camera.orthoHeight <= kMaxScale * radius && *camera.orthoHeight >= radius / kMaxScale)) {
     json::fail("camera.orthoHeight",
@@ -379,11 +451,12 @@ void checkCameraAgainstMesh(const render::CameraSpec& camera,
 
 }  // namespace request
 
-RenderRequest parseRenderRequest(std::string_view body, const JobLimits& limits) {
+RenderRequest parseRenderRequest(std::string_view body, const JobLimits& limits,
+                                 render::mesh::MeshCache* meshes) {
   rapidjson::Document document;
   request::parseJson(body, document);
   try {
-    return parseDocument(document, limits);
+    return parseDocument(document, limits, meshes);
   } catch (const render::InputError& error) {
     throw fromInputError(error);
   }

@@ -30,6 +30,7 @@ std::vector<const char*> requestedPasses(const Outputs& outputs) {
   if (outputs.wireframe) names.push_back(render::pass::kWireframe);
   if (outputs.contours) names.push_back(render::pass::kContours);
   if (outputs.cage) names.push_back(render::pass::kCage);
+  if (outputs.diff) names.push_back(render::pass::kDiff);
   return names;
 }
 
@@ -37,10 +38,12 @@ void writeImages(Writer& w, const render::ImageSet& images, const RenderRequest&
                  const char* owner, std::vector<std::string>& warnings) {
   w.StartObject();
   for (const char* name : requestedPasses(request.job.outputs)) {
-    // The contour and cage overlays are drawn over the method's image; the reference has none.
+    // The contour and cage overlays are drawn over the method's image, and the diff compares
+    // it with the reference; the reference has none of them.
     if (std::string_view(owner) == "reference" &&
         (std::string_view(name) == render::pass::kContours ||
-         std::string_view(name) == render::pass::kCage)) {
+         std::string_view(name) == render::pass::kCage ||
+         std::string_view(name) == render::pass::kDiff)) {
       continue;
     }
     const render::Image* image = images.find(name);
@@ -88,6 +91,7 @@ void writeMetrics(Writer& w, const render::metrics::Metrics& m) {
     w.StartObject();
     numberField(w, "rmse", m.image->rmse);
     numberField(w, "psnr", m.image->psnr);
+    if (m.image->diffScale) numberField(w, "diffScale", *m.image->diffScale);
     w.EndObject();
   }
   if (m.depth) {

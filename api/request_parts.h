@@ -14,6 +14,7 @@
 
 #include "render/core/camera.h"
 #include "render/mesh/control_mesh.h"
+#include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
 
 namespace limn::api::request {
@@ -31,10 +32,13 @@ render::CameraSpec parseCamera(const rapidjson::Value& camera,
                                const render::pipeline::JobLimits& limits,
                                std::vector<std::string>& warnings);
 
-// The mesh in either form ("obj" or "json"), checked against limits.mesh.
+// The mesh in either form ("obj" or "json"), checked against limits.mesh, or {"id": ...}: one
+// uploaded before and held by `meshes` (404 unknown_mesh when it is not there, or there is no
+// cache).
 render::mesh::ControlMesh parseMesh(const rapidjson::Value& mesh,
                                     const render::pipeline::JobLimits& limits,
-                                    std::vector<std::string>& warnings);
+                                    std::vector<std::string>& warnings,
+                                    render::mesh::MeshCache* meshes = nullptr);
 
 // params.presubdivide, searchSteps, curveSamples and contour, where present, into `out`.
 void parseSilhouetteParams(const rapidjson::Value& params,

@@ -13,6 +13,7 @@
 
 #include "api/answer.h"
 #include "render/core/cancel.h"
+#include "render/mesh/mesh_cache.h"
 #include "render/pipeline/contours.h"
 #include "render/pipeline/render_job.h"
 
@@ -29,7 +30,8 @@ struct SilhouetteRequest {
 // Throws ApiError (400 invalid_json / invalid_request, 413 too_large, 422 invalid_mesh).
 // `accept` is the request's Accept header ("" when it had none).
 SilhouetteRequest parseSilhouetteRequest(std::string_view json, std::string_view accept,
-                                         const render::pipeline::JobLimits& limits);
+                                         const render::pipeline::JobLimits& limits,
+                                         render::mesh::MeshCache* meshes = nullptr);
 
 // True when an Accept header ranks image/svg+xml above application/json (q values honoured;
 // "*/*" and absent types do not count).
@@ -51,6 +53,7 @@ std::string writeSilhouetteSvg(const render::pipeline::ContourResult& result,
 // Never throws.
 Answer handleSilhouette(std::string_view body, std::string_view accept,
                         const render::pipeline::JobLimits& limits,
-                        const render::CancelToken& cancel);
+                        const render::CancelToken& cancel,
+                        render::mesh::MeshCache* meshes = nullptr);
 
 }  // namespace limn::api

@@ -67,7 +67,8 @@ bool acceptsSvg(std::string_view accept) {
 }
 
 SilhouetteRequest parseSilhouetteRequest(std::string_view body, std::string_view accept,
-                                         const render::pipeline::JobLimits& limits) {
+                                         const render::pipeline::JobLimits& limits,
+                                         render::mesh::MeshCache* meshes) {
   rapidjson::Document root;
   request::parseJson(body, root);
   try {
@@ -95,7 +96,7 @@ SilhouetteRequest parseSilhouetteRequest(std::string_view body, std::string_view
     }
     const Value* mesh = json::find(root, "mesh");
     if (!mesh) json::fail("mesh", "mesh is required");
-    job.mesh = request::parseMesh(*mesh, limits, out.warnings);
+    job.mesh = request::parseMesh(*mesh, limits, out.warnings, meshes);
     request::checkCameraAgainstMesh(job.camera, job.mesh);
     return out;
   } catch (const render::InputError& error) {

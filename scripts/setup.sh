@@ -14,14 +14,34 @@ packages=(
   clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
 )
 
+# The browser tests (tests/browser): Debian's chromium, and node + npm unless a node is there.
+packages+=(chromium)
+command -v node >/dev/null || packages+=(nodejs npm)
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
 
 if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
-echo "setup: installing ${missing[*]}" >&2
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# playwright-core for the browser tests, exactly as tests/browser/package-lock.json pins it,
+# into build/browser-tests (again only when the lockfile changed). A machine where npm cannot
+# fetch it warns here; the browser test then reports what is missing (tests/browser/run.sh).
+cd "$(dirname "$0")/.."
+tools=build/browser-tests
+if ! cmp -s tests/browser/package-lock.json "$tools/package-lock.json" ||
+   [ ! -f "$tools/node_modules/playwright-core/package.json" ]; then
+  mkdir -p "$tools"
+  cp tests/browser/package.json tests/browser/package-lock.json "$tools/"
+  if ! (cd "$tools" && timeout 300 npm ci --silent --no-audit --no-fund >/dev/null 2>&1); then
+    rm -f "$tools/package-lock.json"
+    echo "setup: WARNING: npm ci of tests/browser/package-lock.json failed; browser tests cannot run" >&2
+  fi
+fi

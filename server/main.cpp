@@ -178,7 +178,8 @@ int serve(const CommandLine& cl) {
     if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token)
       access.authToken = token;
   }
-  server::Router router(config->limits, pool, metrics, access, config->logLevel);
+  render::mesh::MeshCache meshCache(config->meshCacheBytes);
+  server::Router router(config->limits, pool, metrics, access, config->logLevel, &meshCache);
   server::HttpOptions httpOptions;
   httpOptions.host = config->host;
   httpOptions.port = config->port;

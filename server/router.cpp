@@ -7,6 +7,7 @@
 
 #include "api/openapi.h"
 #include "api/silhouette_api.h"
+#include "server/web_assets.h"
 
 #ifndef LIMN_VERSION
 #define LIMN_VERSION "unknown"
@@ -25,6 +26,7 @@ struct Route {
 constexpr Route kRoutes[] = {
     {"/healthz", "GET"},      {"/readyz", "GET"},     {"/metrics", "GET"},
     {"/openapi.json", "GET"}, {"/v1/render", "POST"}, {"/v1/silhouette", "POST"},
+    {"/v1/meshes", "POST"},
 };
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
@@ -79,14 +81,16 @@ std::string Router::routeLabel(std::string_view target) {
   for (const Route& route : kRoutes) {
     if (path == route.path) return std::string(path);
   }
+  if (findWebAsset(path)) return std::string(path);  // a fixed set: the files built in
   return "other";
 }
 
 Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, ServiceMetrics& metrics,
-               AccessOptions access, const std::string& logLevel)
+               AccessOptions access, const std::string& logLevel, render::mesh::MeshCache* meshes)
     : limits_(limits),
       pool_(pool),
       metrics_(metrics),
+      meshes_(meshes),
       access_(std::move(access)),
       log_(logLevel),
       started_(std::chrono::steady_clock::now()) {}
@@ -114,6 +118,8 @@ void Router::route(Request request, Reply reply) {
   for (const Route& route : kRoutes) {
     if (path == route.path) allowed.emplace_back(route.method);
   }
+  const EmbeddedFile* asset = findWebAsset(path);
+  if (asset) allowed.emplace_back("GET");
   if (allowed.empty()) {
     reply(api::errorAnswer({404, "not_found", "no such endpoint: " + std::string(path),
                             "{\"path\":" + jsonString(path) + "}"}));
@@ -133,6 +139,7 @@ void Router::route(Request request, Reply reply) {
     return;
   }
 
+  if (asset) return reply(webAsset(*asset));
   if (path == "/healthz") return reply(healthz());
   if (path == "/readyz") return reply(readyz());
   if (path == "/metrics") return reply(metricsAnswer());
@@ -140,14 +147,40 @@ void Router::route(Request request, Reply reply) {
   if (path == "/v1/silhouette") {
     return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
   }
+  if (path == "/v1/meshes") return uploadMesh(std::move(request.body), std::move(reply));
   render(std::move(request.body), std::move(reply));
+}
+
+// The page and the examples: small and built in, answered on the IO thread. no-cache makes a
+// browser ask again on each load, so a rebuilt server's page is never mixed with an old one.
+api::Answer Router::webAsset(const EmbeddedFile& file) const {
+  api::Answer answer;
+  answer.contentType = file.contentType;
+  answer.body = std::string(file.body());
+  answer.headers.emplace_back("Cache-Control", "no-cache");
+  return answer;
+}
+
+// Parsing a large mesh takes a while: it runs on a worker like a render (same queue, limits and
+// deadline), though it needs no GL context.
+void Router::uploadMesh(std::string body, Reply reply) {
+  if (!meshes_) {
+    return reply(api::errorAnswer(
+        {404, "not_found", "this server keeps no uploaded meshes", "{\"path\":\"/v1/meshes\"}"}));
+  }
+  pool_.submit(
+      [body = std::move(body), limits = limits_, meshes = meshes_](render::pipeline::RenderContext&,
+                                                                   const render::CancelToken&) {
+        return api::handleMeshUpload(body, limits, *meshes);
+      },
+      std::move(reply));
 }
 
 void Router::render(std::string body, Reply reply) {
   pool_.submit(
-      [body = std::move(body), limits = limits_](render::pipeline::RenderContext& context,
-                                                 const render::CancelToken& cancel) {
-        return api::handleRender(body, limits, context, cancel);
+      [body = std::move(body), limits = limits_, meshes = meshes_](
+          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
+        return api::handleRender(body, limits, context, cancel, meshes);
       },
       std::move(reply));
 }
@@ -156,9 +189,9 @@ void Router::render(std::string body, Reply reply) {
 // deadlines for everything that computes.
 void Router::silhouette(std::string body, std::string accept, Reply reply) {
   pool_.submit(
-      [body = std::move(body), accept = std::move(accept), limits = limits_](
+      [body = std::move(body), accept = std::move(accept), limits = limits_, meshes = meshes_](
           render::pipeline::RenderContext&, const render::CancelToken& cancel) {
-        return api::handleSilhouette(body, accept, limits, cancel);
+        return api::handleSilhouette(body, accept, limits, cancel, meshes);
       },
       std::move(reply));
 }

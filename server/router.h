@@ -11,6 +11,8 @@
 //   GET  /openapi.json  the API description
 //   POST /v1/render     api::handleRender on a worker thread
 //   POST /v1/silhouette api::handleSilhouette on a worker thread (same queue, limits, timeout)
+//   POST /v1/meshes     api::handleMeshUpload on a worker thread, into the MeshCache
+//   GET  /, /NAME.js, /examples, /examples/NAME   the built-in page and examples (web_assets.h)
 #pragma once
 
 #include <chrono>
@@ -19,10 +21,12 @@
 #include <string_view>
 
 #include "api/render_api.h"
+#include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
 #include "server/access.h"
 #include "server/request_log.h"
 #include "server/service_metrics.h"
+#include "server/web_assets.h"
 #include "server/worker_pool.h"
 
 namespace limn::server {
@@ -41,8 +45,10 @@ class Router {
   using Reply = std::function<void(api::Answer)>;
 
   // `metrics` (shared with the pool, which records its jobs there) must outlive the router.
+  // `meshes` (owned by the caller, may be null: no uploads) holds POST /v1/meshes' meshes.
   Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, ServiceMetrics& metrics,
-         AccessOptions access = {}, const std::string& logLevel = "info");
+         AccessOptions access = {}, const std::string& logLevel = "info",
+         render::mesh::MeshCache* meshes = nullptr);
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
   // the pool's watchdog for renders.
@@ -61,12 +67,15 @@ class Router {
   api::Answer metricsAnswer() const;
   void render(std::string body, Reply reply);
   void silhouette(std::string body, std::string accept, Reply reply);
+  void uploadMesh(std::string body, Reply reply);
+  api::Answer webAsset(const EmbeddedFile& file) const;
 
   void route(Request request, Reply reply);
 
   render::pipeline::JobLimits limits_;
   WorkerPool& pool_;
   ServiceMetrics& metrics_;
+  render::mesh::MeshCache* meshes_;
   Access access_;
   RequestLog log_;
   std::chrono::steady_clock::time_point started_;

@@ -126,6 +126,14 @@ Camera resolveCamera(const CameraSpec& spec, const Bounds& bounds) {
   double distance = radius / std::sin(radians(fov) * 0.5) * 1.05;
   Vec3 eye = spec.eye.value_or(target + Vec3{0, 0, distance});
   Vec3 up = spec.up.value_or(Vec3{0, 1, 0});
+  if (spec.orbit) {
+    const double az = radians(spec.orbit->azimuthDeg), el = radians(spec.orbit->elevationDeg);
+    const Vec3 toEye{std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+    eye = target + toEye * (spec.orbit->distance ? *spec.orbit->distance * radius : distance);
+    // d(toEye)/d(elevation): perpendicular to the view, "up" on the sphere at any elevation.
+    up = spec.up.value_or(
+        Vec3{-std::sin(el) * std::sin(az), std::cos(el), -std::sin(el) * std::cos(az)});
+  }
   double orthoHeight = spec.orthoHeight.value_or(radius * 2.1);
   int width = spec.width.value_or(kDefaultImageSide);
   int height = spec.height.value_or(kDefaultImageSide);

@@ -5,7 +5,8 @@
 //  - the ray of a pixel goes through its centre (i + 0.5, j + 0.5);
 //  - "depth" is linear depth along the viewing direction (eye-space distance, not NDC).
 // CameraSpec holds what a request said; resolveCamera() fills what it left out from the
-// surface's bounds (the default frames the bounding sphere from +Z).
+// surface's bounds (the default frames the bounding sphere from +Z). An Orbit places the eye
+// by angles around the target instead of by position.
 #pragma once
 
 #include <array>
@@ -17,8 +18,17 @@ namespace limn::render {
 
 enum class Projection { Perspective, Orthographic };
 
+// The eye on a sphere around the target: azimuth about +Y from +Z towards +X, elevation up
+// from the XZ plane (degrees), distance in bounding-sphere radii (none: the default framing).
+// Azimuth 0, elevation 0 is the default view from +Z.
+struct Orbit {
+  double azimuthDeg = 0, elevationDeg = 0;
+  std::optional<double> distance;
+};
+
 struct CameraSpec {
   std::optional<Vec3> eye, target, up;
+  std::optional<Orbit> orbit;  // an alternative to eye (not both)
   std::optional<double> fovYDeg;
   std::optional<Projection> projection;
   std::optional<double> orthoHeight;
@@ -82,7 +92,9 @@ inline constexpr int kDefaultImageSide = 512;
 
 // Fills what the spec leaves out: target = bounds centre, eye on +Z at a distance that frames
 // the bounding sphere, up = +Y, 35 degrees, perspective, 512 x 512; orthoHeight frames the
-// sphere. Near and far planes enclose the bounding sphere.
+// sphere. Near and far planes enclose the bounding sphere. With an orbit, the eye sits at its
+// angles and distance from the target and `up` defaults to the sphere's local up (tilted with
+// the elevation, so the view stays upright over the poles).
 Camera resolveCamera(const CameraSpec& spec, const Bounds& bounds);
 
 }  // namespace limn::render

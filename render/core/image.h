@@ -35,6 +35,7 @@ inline constexpr const char* kNormal = "normal";        // 3 channels, unit worl
 inline constexpr const char* kWireframe = "wireframe";  // RGBA, colour with edges drawn over
 inline constexpr const char* kContours = "contours";    // RGBA, colour with the contour drawn over
 inline constexpr const char* kCage = "cage";  // RGBA, colour with the control cage drawn over
+inline constexpr const char* kDiff = "diff";  // RGBA, heat map of the colour difference
 }  // namespace pass
 
 // The passes of one rendering (approximation or reference) of one camera.

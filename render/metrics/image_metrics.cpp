@@ -1,6 +1,8 @@
-// compareColor(), compareDepth(), compareNormals(): per-pixel differences between two renderings
-// of the same camera, over the pixels DESIGN.md names (covered in either / in both).
+// compareColor(), colorDifference(), compareDepth(), compareNormals(): per-pixel differences
+// between two renderings of the same camera, over the pixels DESIGN.md names (covered in either /
+// in both).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -97,6 +99,57 @@ ColorMetrics compareColor(const ImageSet& approx, const ImageSet& reference) {
   // Peak value 1 (colours in [0,1]); capped so identical images give a finite number.
   result.psnr =
       result.rmse > 0 ? std::min(kMaxPsnr, 20.0 * std::log10(1.0 / result.rmse)) : kMaxPsnr;
+  return result;
+}
+
+namespace {
+
+// A dark-to-bright ramp (black, purple, red, orange, pale yellow, after matplotlib's "inferno"):
+// brightness grows with the value, so it reads in grey print too.
+std::array<float, 3> heatRamp(double t) {
+  static constexpr float kStops[][3] = {{0.00f, 0.00f, 0.02f},
+                                        {0.34f, 0.06f, 0.43f},
+                                        {0.73f, 0.21f, 0.33f},
+                                        {0.98f, 0.55f, 0.04f},
+                                        {0.99f, 1.00f, 0.64f}};
+  constexpr int kSegments = 4;
+  const double x = std::clamp(t, 0.0, 1.0) * kSegments;
+  const int i = std::min(static_cast<int>(x), kSegments - 1);
+  const float f = static_cast<float>(x - i);
+  std::array<float, 3> rgb{};
+  for (int c = 0; c < 3; ++c) rgb[c] = kStops[i][c] + f * (kStops[i + 1][c] - kStops[i][c]);
+  return rgb;
+}
+
+}  // namespace
+
+DiffImage colorDifference(const ImageSet& approx, const ImageSet& reference) {
+  const Image& a = requirePass(approx, pass::kColor, 3, "approximation");
+  const Image& b = requirePass(reference, pass::kColor, 3, "reference");
+  requireSameSize(a, b, pass::kColor);
+  const std::vector<uint8_t> coveredA = coveredPixels(approx, a.width, a.height, "approximation");
+  const std::vector<uint8_t> coveredB = coveredPixels(reference, b.width, b.height, "reference");
+
+  constexpr double kSmallestScale = 1.0 / 255.0;          // one step of an 8-bit colour
+  std::vector<double> difference(coveredA.size(), -1.0);  // -1: covered in neither
+  double scale = kSmallestScale;
+  for (size_t i = 0; i < coveredA.size(); ++i) {
+    if (!coveredA[i] && !coveredB[i]) continue;
+    double d = 0;
+    for (int c = 0; c < 3; ++c) {
+      d = std::max(d, std::abs(static_cast<double>(a.pixels[i * a.channels + c]) -
+                               static_cast<double>(b.pixels[i * b.channels + c])));
+    }
+    difference[i] = d;
+    scale = std::max(scale, d);
+  }
+  DiffImage result{Image(a.width, a.height, 4), scale};
+  for (size_t i = 0; i < difference.size(); ++i) {
+    if (difference[i] < 0) continue;  // transparent
+    const std::array<float, 3> rgb = heatRamp(difference[i] / scale);
+    float* out = &result.image.pixels[i * 4];
+    out[0] = rgb[0], out[1] = rgb[1], out[2] = rgb[2], out[3] = 1.0f;
+  }
   return result;
 }
 

@@ -21,6 +21,8 @@ struct SilhouetteMetrics {
 };
 struct ColorMetrics {
   double rmse = 0, psnr = 0;
+  // The colour difference at the top of the diff heat map's ramp (when one was drawn).
+  std::optional<double> diffScale;
 };
 struct DepthMetrics {
   double maxRel = 0, meanRel = 0;
@@ -55,6 +57,15 @@ SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMa
 // RGB over pixels covered in either. psnr = 20 log10(1 / rmse), capped at 100 dB (identical
 // images would otherwise be infinite, which JSON cannot carry).
 ColorMetrics compareColor(const ImageSet& approx, const ImageSet& reference);
+// The per-pixel colour difference as a heat map (image_metrics.cpp has the ramp): for each
+// pixel covered in either rendering, d = the largest |approx - reference| of R, G, B, drawn as
+// ramp(d / scale) with scale = the largest d (at least 1/255, one 8-bit step); pixels covered
+// in neither are transparent. Same passes and coverage rules as compareColor.
+struct DiffImage {
+  Image image;  // RGBA
+  double scale = 0;
+};
+DiffImage colorDifference(const ImageSet& approx, const ImageSet& reference);
 // Over pixels covered in both; relative to `diagonal` (the mesh's bounding-box diagonal).
 DepthMetrics compareDepth(const ImageSet& approx, const ImageSet& reference, double diagonal);
 // Angle between the normalised normals where both are covered; pixels with a zero normal are

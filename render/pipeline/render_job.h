@@ -51,6 +51,7 @@ struct Outputs {
   bool color = true, mask = false, depth = false, normal = false, wireframe = false;
   bool contours = false;  // silhouette: contour curves, corrected faces, searched edges
   bool cage = false;      // the control mesh's edges drawn over the colour image
+  bool diff = false;      // a heat map of the colour difference against the reference
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.

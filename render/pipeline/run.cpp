@@ -51,6 +51,11 @@ void checkJob(const RenderJob& job, const JobLimits& limits) {
   if (job.reference && job.method != Method::Limit) {
     checkSupersampledMasks(job.camera, p.metricSupersample, limits);
   }
+  if (job.outputs.diff && (!job.reference || job.method == Method::Limit)) {
+    badParameter("outputs",
+                 "\"diff\" compares a method's colour with the reference: it needs "
+                 "\"reference\": true and a method other than \"limit\"");
+  }
 }
 
 // Normal-map shading: an atlas of the limit normals of `surface`'s faces, sized so the face
@@ -147,6 +152,7 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   if (!isReference) keep(outputs.wireframe, pass::kWireframe);
   if (!isReference) keep(outputs.contours, pass::kContours);
   if (!isReference) keep(outputs.cage, pass::kCage);
+  if (!isReference) keep(outputs.diff, pass::kDiff);
   return selected;
 }
 
@@ -299,6 +305,11 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       result.metrics.depth =
           metrics::compareDepth(approxImages, refImages, surface.bounds().diagonal());
       result.metrics.normal = metrics::compareNormals(approxImages, refImages);
+      if (job.outputs.diff) {
+        metrics::DiffImage diff = metrics::colorDifference(approxImages, refImages);
+        result.metrics.image->diffScale = diff.scale;
+        result.images.passes[pass::kDiff] = std::move(diff.image);
+      }
     }
     if (job.method == Method::Limit) {
       result.images = selectOutputs(reference.images, job.outputs, true);

@@ -858,7 +858,8 @@ render::pipeline::RenderResult handMadeResult() {
 
   render::metrics::Metrics metrics;
   metrics.silhouette = render::metrics::SilhouetteMetrics{0.31, 0.05, 0.9991, 212, 0.087, 0.012};
-  metrics.image = render::metrics::ColorMetrics{0.004, std::numeric_limits<double>::infinity()};
+  metrics.image =
+      render::metrics::ColorMetrics{0.004, std::numeric_limits<double>::infinity(), std::nullopt};
   metrics.geometry = render::metrics::GeometryMetrics{0.0002, std::nan(""), 0.00004};
 
   render::pipeline::Stats stats;
@@ -1075,6 +1076,7 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_EQ(file.limits.maxTriangles, builtIn.limits.maxTriangles);
   EXPECT_EQ(file.limits.mesh.maxValence, builtIn.limits.mesh.maxValence);
   EXPECT_EQ(file.referenceCacheBytes, builtIn.referenceCacheBytes);
+  EXPECT_EQ(file.meshCacheBytes, builtIn.meshCacheBytes);
   EXPECT_TRUE(file.authToken.empty());
   EXPECT_TRUE(file.corsOrigins.empty());
   EXPECT_EQ(file.logLevel, builtIn.logLevel);
@@ -1141,6 +1143,80 @@ TEST(OpenApi, EmbeddedDocumentIsTheFileAndDescribesTheEndpoints) {
   for (const char* schema : {"RenderRequest", "RenderResponse", "Error"}) {
     EXPECT_TRUE(schemas.HasMember(schema)) << schema;
   }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// What the web page sends: orbit cameras, the diff output, meshes by id
+
+namespace {
+
+TEST(RenderRequest, ReadsAnOrbitCamera) {
+  api::RenderRequest r = api::parseRenderRequest(
+      cubeRequest(
+          R"(, "camera": {"orbit": {"azimuthDeg": 30, "elevationDeg": -20, "distance": 3}})"),
+      {});
+  ASSERT_TRUE(r.job.camera.orbit.has_value());
+  EXPECT_EQ(r.job.camera.orbit->azimuthDeg, 30);
+  EXPECT_EQ(r.job.camera.orbit->elevationDeg, -20);
+  EXPECT_EQ(r.job.camera.orbit->distance, 3);
+  EXPECT_FALSE(r.job.camera.eye.has_value());
+  api::RenderRequest bare =
+      api::parseRenderRequest(cubeRequest(R"(, "camera": {"orbit": {}})"), {});
+  EXPECT_FALSE(bare.job.camera.orbit->distance.has_value());
+
+  ApiError both = parseError(cubeRequest(R"(, "camera": {"orbit": {}, "eye": [0, 0, 4]})"));
+  expectError(both, 400, "invalid_request");
+  EXPECT_EQ(detailMember(both, "field"), "camera.orbit");
+  EXPECT_EQ(detailMember(parseError(cubeRequest(R"(, "camera": {"orbit": {"elevationDeg": -91}})")),
+                         "field"),
+            "camera.orbit.elevationDeg");
+  EXPECT_EQ(
+      detailMember(parseError(cubeRequest(R"(, "camera": {"orbit": {"distance": -1}})")), "field"),
+      "camera.orbit.distance");
+  EXPECT_EQ(detailMember(parseError(cubeRequest(R"(, "camera": {"orbit": [0, 0]})")), "field"),
+            "camera.orbit");
+}
+
+TEST(RenderRequest, DiffNeedsTheReference) {
+  api::RenderRequest r = api::parseRenderRequest(
+      cubeRequest(R"(, "outputs": ["color", "diff"], "reference": true)"), {});
+  EXPECT_TRUE(r.job.outputs.diff);
+  ApiError alone = parseError(cubeRequest(R"(, "outputs": ["diff"])"));
+  expectError(alone, 400, "invalid_request");
+  EXPECT_TRUE(contains(alone.message, "\"reference\": true")) << alone.message;
+  expectError(
+      parseError(cubeRequest(R"(, "method": "limit", "outputs": ["diff"], "reference": true)")),
+      400, "invalid_request");
+}
+
+TEST(RenderRequest, MeshByIdComesFromTheCache) {
+  render::mesh::MeshCache cache(1 << 20);
+  api::RenderRequest inline_ = api::parseRenderRequest(cubeRequest(""), {});
+  const std::string id = cache.put(inline_.job.mesh).id;
+  api::RenderRequest byId =
+      api::parseRenderRequest(R"({"mesh": {"id": ")" + id + R"("}})", {}, &cache);
+  EXPECT_EQ(byId.job.mesh.faceVertexIndices, inline_.job.mesh.faceVertexIndices);
+  EXPECT_EQ(byId.job.mesh.points.size(), 8u);
+
+  auto error = [&](const std::string& body, render::mesh::MeshCache* meshes) -> ApiError {
+    try {
+      api::parseRenderRequest(body, {}, meshes);
+    } catch (const ApiError& e) {
+      return e;
+    }
+    ADD_FAILURE() << "accepted " << body;
+    return {0, "", ""};
+  };
+  ApiError unknown = error(R"({"mesh": {"id": "feed"}})", &cache);
+  expectError(unknown, 404, "unknown_mesh");
+  EXPECT_EQ(detailMember(unknown, "id"), "feed");
+  expectError(error(R"({"mesh": {"id": ")" + id + R"("}})", nullptr), 404, "unknown_mesh");
+  ApiError extra = error(R"({"mesh": {"id": ")" + id + R"(", "format": "obj"}})", &cache);
+  expectError(extra, 400, "invalid_request");
+  EXPECT_EQ(detailMember(extra, "field"), "mesh.format");
+  expectError(error(R"({"mesh": {"id": 7}})", &cache), 400, "invalid_request");
 }
 
 }  // namespace

@@ -331,6 +331,36 @@ TEST(Color, WithoutMaskPassAlphaTellsCoverage) {
   EXPECT_NEAR(compareColor(a, b).rmse, std::sqrt(0.04 / 3), 1e-6);
 }
 
+TEST(ColorDifference, HeatMapScaledToTheLargestDifference) {
+  ImageSet a = rendering(3, 1), b = rendering(3, 1);
+  a.passes[pass::kMask].at(2, 0) = 0;  // pixel 2 covered in neither: transparent
+  b.passes[pass::kMask].at(2, 0) = 0;
+  b.passes[pass::kColor].at(2, 0, 0) = 1.0f;  // ... whatever its colour
+  b.passes[pass::kColor].at(0, 0, 1) = 0.9f;  // pixel 0 off by 0.4 in green: the largest
+  b.passes[pass::kColor].at(1, 0, 2) = 0.6f;  // pixel 1 off by 0.1 in blue
+  const DiffImage diff = colorDifference(a, b);
+  EXPECT_NEAR(diff.scale, 0.4, 1e-6);
+  ASSERT_EQ(diff.image.channels, 4);
+  EXPECT_EQ(diff.image.at(2, 0, 3), 0.0f);
+  EXPECT_EQ(diff.image.at(0, 0, 3), 1.0f);
+  EXPECT_EQ(diff.image.at(1, 0, 3), 1.0f);
+  // The top of the ramp is bright, a quarter of it dark; brightness grows with the difference.
+  auto brightness = [&](int x) {
+    return diff.image.at(x, 0, 0) + diff.image.at(x, 0, 1) + diff.image.at(x, 0, 2);
+  };
+  EXPECT_GT(brightness(0), 2.5f);
+  EXPECT_LT(brightness(1), 1.0f);
+  EXPECT_GT(brightness(1), 0.0f);
+}
+
+TEST(ColorDifference, IdenticalImagesAreTheDarkEndWithTheSmallestScale) {
+  const ImageSet a = rendering(2, 2);
+  const DiffImage diff = colorDifference(a, a);
+  EXPECT_NEAR(diff.scale, 1.0 / 255.0, 1e-12);
+  EXPECT_LT(diff.image.at(1, 1, 0) + diff.image.at(1, 1, 1) + diff.image.at(1, 1, 2), 0.05f);
+  EXPECT_THROW(colorDifference(a, rendering(3, 2)), std::invalid_argument);
+}
+
 TEST(Color, IdenticalImagesHaveCappedPsnr) {
   const ImageSet a = rendering(3, 3);
   const ColorMetrics m = compareColor(a, a);

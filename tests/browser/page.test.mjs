@@ -1,0 +1,227 @@
+// Browser tests of limn's page at "/": Debian's chromium, driven by playwright-core, against the
+// real `limn serve` on 127.0.0.1 (a free port). Each test does what a person would and checks
+// what they would see. Screenshots go to LIMN_ARTIFACTS (build/web-artifacts); the times from
+// opening the page to the first picture and from a drag's end to the full-size picture are
+// printed (docs/web.md reports them).
+//
+// Run through CTest (label "browser") or tests/browser/run.sh, which finds node, the npm
+// packages (LIMN_NODE_MODULES) and chromium first.
+import assert from "node:assert/strict";
+import { spawn } from "node:child_process";
+import { mkdirSync, writeFileSync } from "node:fs";
+import { createRequire } from "node:module";
+import path from "node:path";
+import { after, before, describe, it } from "node:test";
+
+const binary = process.env.LIMN_BINARY;
+const artifacts = process.env.LIMN_ARTIFACTS || "build/web-artifacts";
+const require = createRequire(path.join(process.env.LIMN_NODE_MODULES, "index.js"));
+const { chromium } = require("playwright-core");
+
+let server, baseUrl, browser, page;
+const timings = {};
+
+// `limn serve` on a free port; resolves once it prints where it listens.
+function startServer() {
+  return new Promise((resolve, reject) => {
+    server = spawn(binary, ["serve", "--listen", "127.0.0.1:0"],
+                   { stdio: ["ignore", "pipe", "pipe"] });
+    let out = "";
+    server.stdout.on("data", (chunk) => {
+      out += chunk;
+      const match = out.match(/listening on (http:\/\/\S+)/);
+      if (match) resolve(match[1]);
+    });
+    server.stderr.on("data", () => {});  // the request log
+    server.on("exit", (code) => reject(new Error(`limn serve exited with ${code}: ${out}`)));
+  });
+}
+
+async function shot(name, locator = page) {
+  await locator.screenshot({ path: path.join(artifacts, `${name}.png`) });
+}
+
+// Waits until the page has shown `n` full-size pictures in all.
+async function waitForRenders(n) {
+  await page.waitForFunction((k) => window.limnPage.renders >= k, n, { timeout: 120_000 });
+}
+
+// The fraction of an <img>'s pixels that show something: opaque and not near white.
+async function inkFraction(selector) {
+  return page.$eval(selector, (img) => {
+    const canvas = document.createElement("canvas");
+    canvas.width = img.naturalWidth;
+    canvas.height = img.naturalHeight;
+    const ctx = canvas.getContext("2d");
+    ctx.drawImage(img, 0, 0);
+    const { data } = ctx.getImageData(0, 0, canvas.width, canvas.height);
+    let ink = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      if (data[i + 3] > 128 && data[i] + data[i + 1] + data[i + 2] < 3 * 235) ink += 1;
+    }
+    return ink / (data.length / 4);
+  });
+}
+
+// The fraction of pixels that differ between the picture now and `before` (RGBA arrays).
+async function pixels(selector) {
+  return page.$eval(selector, (img) => {
+    const canvas = document.createElement("canvas");
+    canvas.width = img.naturalWidth;
+    canvas.height = img.naturalHeight;
+    const ctx = canvas.getContext("2d");
+    ctx.drawImage(img, 0, 0);
+    return Array.from(ctx.getImageData(0, 0, canvas.width, canvas.height).data);
+  });
+}
+
+function differingFraction(a, b) {
+  assert.equal(a.length, b.length, "pictures of different sizes");
+  let differ = 0;
+  for (let i = 0; i < a.length; i += 4) {
+    const d = Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) +
+              Math.abs(a[i + 3] - b[i + 3]);
+    if (d > 24) differ += 1;
+  }
+  return differ / (a.length / 4);
+}
+
+// Changes a control the way a person does (the value, then the change event).
+async function set(selector, value) {
+  const renders = await page.evaluate(() => window.limnPage.renders);
+  await page.$eval(selector, (el, v) => {
+    if (el.type === "checkbox") el.checked = v; else el.value = String(v);
+    el.dispatchEvent(new Event("input", { bubbles: true }));
+    el.dispatchEvent(new Event("change", { bubbles: true }));
+  }, value);
+  return renders;
+}
+
+const triangles = () => page.$eval("#stats", (el) => Number(el.dataset.triangles));
+
+describe("limn's page", () => {
+  before(async () => {
+    mkdirSync(artifacts, { recursive: true });
+    baseUrl = await startServer();
+    browser = await chromium.launch({
+      executablePath: process.env.LIMN_CHROMIUM || "/usr/bin/chromium",
+      args: ["--no-sandbox", "--disable-dev-shm-usage"],
+    });
+    page = await browser.newPage({ viewport: { width: 1240, height: 800 } });
+    page.on("pageerror", (error) => console.log(`page error: ${error.message}`));
+  });
+
+  after(async () => {
+    await browser?.close();
+    server?.kill("SIGTERM");
+    writeFileSync(path.join(artifacts, "timings.json"), JSON.stringify(timings, null, 2));
+  });
+
+  it("opens with an example rendered", async () => {
+    const opened = Date.now();
+    await page.goto(baseUrl + "/");
+    await waitForRenders(1);
+    timings.firstPictureMs = Date.now() - opened;
+    timings.firstPictureSinceNavigationMs = await page.evaluate(() => window.limnPage.firstPictureMs);
+    console.log(`time to first picture: ${timings.firstPictureMs} ms from goto ` +
+                `(${timings.firstPictureSinceNavigationMs.toFixed(0)} ms after navigation start)`);
+    assert.equal(await page.$eval("#example", (el) => el.value), "torus_creased");
+    const ink = await inkFraction("#picture");
+    assert.ok(ink > 0.05, `the first picture is blank (${(100 * ink).toFixed(2)}% ink)`);
+    assert.match(await page.textContent("#mesh-info"), /96 vertices, 96 faces/);
+    await shot("first-load");
+  });
+
+  it("shows more triangles for more iterations, with the cage over the surface", async () => {
+    await set("#draw-cage", true);
+    let n = await set("#level", 1);
+    await waitForRenders(n + 1);
+    const one = await triangles();
+    await shot("cage-level-1", page.locator("#approx-panel"));
+    n = await set("#level", 2);
+    await waitForRenders(n + 1);
+    await shot("cage-level-2", page.locator("#approx-panel"));
+    n = await set("#level", 3);
+    await waitForRenders(n + 1);
+    const three = await triangles();
+    await shot("cage-level-3", page.locator("#approx-panel"));
+    // The torus is all quads: each level splits a quad into four, two triangles each.
+    assert.equal(one, 96 * 2 * 4);
+    assert.equal(three, 96 * 2 * 64);
+    assert.match(await page.textContent("#stats"), /12,288 triangles/);
+  });
+
+  it("changes the picture when the cage is toggled", async () => {
+    const withCage = await pixels("#picture");
+    const n = await set("#draw-cage", false);
+    await waitForRenders(n + 1);
+    const without = await pixels("#picture");
+    const changed = differingFraction(withCage, without);
+    assert.ok(changed > 0.005, `only ${(100 * changed).toFixed(3)}% of the pixels changed`);
+  });
+
+  it("orbits on a drag: previews while dragging, a new full-size render after", async () => {
+    const azimuth = await page.$eval("#view", (el) => Number(el.dataset.azimuth));
+    const { renders, previews } = await page.evaluate(() => ({ ...window.limnPage }));
+    const before = await pixels("#picture");
+    const box = await page.locator("#view").boundingBox();
+    const x = box.x + box.width / 2, y = box.y + box.height / 2;
+    await page.mouse.move(x, y);
+    await page.mouse.down();
+    for (let i = 1; i <= 30; i++) {
+      await page.mouse.move(x + 6 * i, y + 2 * i);
+      await page.waitForTimeout(30);
+    }
+    await page.mouse.up();
+    await waitForRenders(renders + 1);
+    const state = await page.evaluate(() => ({ ...window.limnPage }));
+    timings.dragToFullMs = state.dragToFullMs;
+    console.log(`drag end to full-size picture: ${state.dragToFullMs.toFixed(0)} ms ` +
+                `(${state.previews - previews} previews during the drag)`);
+    const after = await page.$eval("#view", (el) => Number(el.dataset.azimuth));
+    assert.ok(Math.abs(after - azimuth) > 45, `azimuth ${azimuth} -> ${after}`);
+    assert.ok(state.previews > previews, "no preview arrived during the drag");
+    assert.ok(differingFraction(before, await pixels("#picture")) > 0.01, "the view did not turn");
+    assert.equal(await page.$eval("#picture", (img) => img.naturalWidth), 512);
+  });
+
+  it("says what is wrong with an uploaded broken OBJ, next to the mesh controls", async () => {
+    await page.setInputFiles("#upload", {
+      name: "broken.obj", mimeType: "text/plain",
+      buffer: Buffer.from("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n"),
+    });
+    const error = page.locator("#mesh-error");
+    await error.waitFor({ state: "visible" });
+    const text = await error.textContent();
+    assert.match(text, /^422: /);
+    assert.match(text, /line 5/);
+    assert.match(text, /face 1 uses vertex 7/);
+    await shot("error-broken-obj");
+  });
+
+  it("compares with the reference: metrics, reference and diff", async () => {
+    await page.selectOption("#example", "pawn");
+    await page.waitForFunction(() => /Pawn/.test(document.querySelector("#mesh-info").textContent));
+    await waitForRenders((await page.evaluate(() => window.limnPage.renders)) + 1);
+    await page.selectOption("#method", "uniform");
+    const n = await set("#level", 1);
+    await waitForRenders(n + 1);
+    const m = await set("#compare", true);
+    await waitForRenders(m + 1);
+    await page.locator("#metrics").waitFor({ state: "visible" });
+    const table = await page.textContent("#metrics");
+    for (const name of ["outline Hausdorff (px)", "IoU", "PSNR (dB)", "normal mean (deg)",
+                        "triangles", "reference"]) {
+      assert.ok(table.includes(name), `metrics table lacks ${name}`);
+    }
+    const answer = await page.evaluate(() => window.limnPage.lastAnswer.metrics);
+    assert.ok(answer.silhouette.hausdorffPx > 0, "level 1 should differ from the limit");
+    const scale = Number(await page.textContent("#diff-scale"));
+    assert.ok(scale > 0 && scale <= 1, `diff scale ${scale}`);
+    assert.ok(await inkFraction("#reference") > 0.05, "the reference is blank");
+    assert.ok(await inkFraction("#diff") > 0.02, "the diff is blank");
+    await shot("compare");
+    await page.check("input[value=slider]");
+    await shot("compare-slider", page.locator("#approx-panel"));
+  });
+});

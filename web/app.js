@@ -1,0 +1,545 @@
+// limn's page: pick or upload a mesh, choose a method and what to draw, orbit the camera, and
+// compare the approximation with the exact reference. Every picture comes from the server
+// (POST /v1/render); while the camera is dragged, small renders keep the view moving and the
+// full-size one follows when the drag ends. See docs/web.md.
+import { ApiProblem, UploadedMesh, getJson, getText, post } from "/api.js";
+
+const $ = (id) => document.getElementById(id);
+const DEFAULT_VIEW = { azimuthDeg: 30, elevationDeg: 20, distance: null };
+const PREVIEW_DIVISOR = 4;  // drag previews render at a quarter of the size in each direction
+
+// What the browser tests (and a curious person in the console) can read.
+const page = (window.limnPage = {
+  renders: 0,            // full-size pictures shown
+  previews: 0,           // drag previews shown
+  firstPictureMs: null,  // performance.now() when the first full-size picture was shown
+  dragToFullMs: null,    // from the last drag's end to its full-size picture
+  lastAnswer: null,
+});
+
+const state = {
+  examples: [],
+  mesh: null,           // UploadedMesh
+  meshText: null,       // OBJ text or JSON mesh object, for the client-side cage
+  view: { ...DEFAULT_VIEW },
+  full: null,           // AbortController of the full-size render in flight
+  preview: { busy: false, again: false },
+  dragEndedAt: null,
+};
+
+// ---------------------------------------------------------------- errors next to controls
+
+const errorSlots = { mesh: "mesh-error", method: "method-error", draw: "draw-error",
+                     view: "page-error", page: "page-error" };
+
+function clearErrors() {
+  for (const id of new Set(Object.values(errorSlots))) $(id).hidden = true;
+}
+
+function showError(problem) {
+  const slot = problem instanceof ApiProblem ? errorSlots[problem.control] : "page-error";
+  const text = problem instanceof ApiProblem ? `${problem.status}: ${problem.text}`
+                                             : `Could not reach limn: ${problem.message}`;
+  $(slot).textContent = text;
+  $(slot).hidden = false;
+}
+
+function setBusy(text) {
+  $("progress").hidden = !text;
+  if (text) $("progress-text").textContent = text;
+}
+
+// ---------------------------------------------------------------- the request
+
+function methodParams() {
+  const method = $("method").value;
+  if (method === "uniform") return { level: Number($("level").value), engine: $("engine").value };
+  if (method === "adaptive") return { dicingRate: Number($("dicing-rate").value) };
+  if (method === "silhouette") {
+    const p = $("presubdivide").value;
+    return { contour: $("contour-mode").value, presubdivide: p === "auto" ? "auto" : Number(p) };
+  }
+  return {};
+}
+
+// The image the view shows: the cage drawn over the surface, or its wireframe, or its colour.
+function mainOutput() {
+  if ($("draw-cage").checked && $("method").value !== "limit") return "cage";
+  if ($("draw-wireframe").checked) return "wireframe";
+  return "color";
+}
+
+function cameraFor(size) {
+  const orbit = { azimuthDeg: state.view.azimuthDeg, elevationDeg: state.view.elevationDeg };
+  if (state.view.distance) orbit.distance = state.view.distance;
+  return { orbit, width: size, height: size };
+}
+
+function renderBody(mesh, size, compare) {
+  const outputs = [mainOutput()];
+  if (compare) outputs.push("diff");
+  return { mesh, camera: cameraFor(size), method: $("method").value, params: methodParams(),
+           shading: $("shading").value, outputs, reference: compare };
+}
+
+const fullSize = () => Number($("size").value);
+const comparing = () => $("compare").checked && $("method").value !== "limit";
+
+// ---------------------------------------------------------------- rendering
+
+function imageUrl(image) { return `data:${image.mime};base64,${image.data}`; }
+
+function showImage(img, image) {
+  return new Promise((resolve) => {
+    img.onload = img.onerror = () => resolve();
+    img.src = imageUrl(image);
+  });
+}
+
+// The full-size picture (and, comparing, the reference, the diff and the metrics). A newer
+// call aborts the one in flight: only the latest camera and settings are worth finishing.
+async function renderFull() {
+  if (!state.mesh) return;
+  state.full?.abort();
+  const controller = (state.full = new AbortController());
+  const compare = comparing();
+  setBusy(compare ? "rendering and ray-casting the reference…" : "rendering…");
+  const contours = $("draw-contours").checked ? loadContours(controller.signal) : null;
+  try {
+    const answer = await state.mesh.withId(
+        (mesh) => post("/v1/render", renderBody(mesh, fullSize(), compare),
+                       { signal: controller.signal }),
+        controller.signal);
+    if (controller.signal.aborted) return;
+    clearErrors();
+    await showAnswer(answer, compare);
+    if (controller.signal.aborted) return;
+    page.renders += 1;
+    page.lastAnswer = answer;
+    const now = performance.now();
+    if (page.firstPictureMs === null) page.firstPictureMs = now;
+    if (state.dragEndedAt !== null) {
+      page.dragToFullMs = now - state.dragEndedAt;
+      state.dragEndedAt = null;
+    }
+    $("view").dataset.renders = String(page.renders);
+  } catch (problem) {
+    if (problem.name === "AbortError") return;
+    showError(problem);
+    if (problem instanceof ApiProblem && problem.status === 429) {
+      setTimeout(renderFull, problem.retryAfter * 1000);
+    }
+  } finally {
+    if (state.full === controller) {
+      state.full = null;
+      setBusy(null);
+    }
+  }
+  await contours;
+}
+
+async function showAnswer(answer, compare) {
+  const image = answer.images[mainOutput()] || answer.images.color;
+  const shown = [showImage($("picture"), image)];
+  $("picture").classList.toggle("hidden-surface", !$("draw-surface").checked);
+  drawClientCage(answer.camera);
+  const s = answer.stats, t = answer.timings;
+  $("stats").textContent = `${s.triangles.toLocaleString("en")} triangles · ` +
+      `${s.controlFaces} control faces · ${t.totalMs.toFixed(0)} ms`;
+  $("stats").dataset.triangles = String(s.triangles);
+  document.body.classList.toggle("comparing", compare);
+  if (compare) {
+    shown.push(showImage($("reference"), answer.reference.images.color));
+    shown.push(showImage($("slider-reference"), answer.reference.images.color));
+    if (answer.images.diff) shown.push(showImage($("diff"), answer.images.diff));
+    $("diff-scale").textContent = formatNumber(answer.metrics.image?.diffScale);
+    fillMetrics(answer);
+  }
+  await Promise.all(shown);
+}
+
+// Drag previews: at most one in flight; when it lands, the newest camera goes next.
+async function renderPreview() {
+  if (!state.mesh) return;
+  if (state.preview.busy) {
+    state.preview.again = true;
+    return;
+  }
+  state.preview.busy = true;
+  try {
+    const size = Math.max(64, Math.round(fullSize() / PREVIEW_DIVISOR));
+    const answer = await state.mesh.withId(
+        (mesh) => post("/v1/render", renderBody(mesh, size, false)));
+    if (state.dragging || state.full === null) {
+      await showImage($("picture"), answer.images[mainOutput()] || answer.images.color);
+      drawClientCage(answer.camera);
+      page.previews += 1;
+    }
+  } catch (problem) {
+    if (problem.name !== "AbortError") showError(problem);
+  } finally {
+    state.preview.busy = false;
+    if (state.preview.again && state.dragging) {
+      state.preview.again = false;
+      renderPreview();
+    }
+  }
+}
+
+// The contour of the limit surface (POST /v1/silhouette, SVG: hidden pieces dashed), laid over
+// the picture and the reference with a multiply blend so its white background disappears.
+async function loadContours(signal) {
+  try {
+    const svg = await state.mesh.withId(
+        (mesh) => post("/v1/silhouette", { mesh, camera: cameraFor(fullSize()), format: "svg" },
+                       { signal, accept: "image/svg+xml" }), signal);
+    for (const id of ["contours-overlay", "reference-contours"]) {
+      $(id).innerHTML = svg;
+      $(id).hidden = false;
+    }
+  } catch (problem) {
+    if (problem.name !== "AbortError") showError(problem);
+  }
+}
+
+function hideContours() {
+  for (const id of ["contours-overlay", "reference-contours"]) $(id).hidden = true;
+}
+
+// ---------------------------------------------------------------- metrics table
+
+function formatNumber(x) {
+  if (x === undefined || x === null) return "–";
+  if (Number.isInteger(x)) return x.toLocaleString("en");
+  const a = Math.abs(x);
+  return a !== 0 && (a < 1e-3 || a >= 1e6) ? x.toExponential(2) : x.toPrecision(4);
+}
+
+function fillMetrics(answer) {
+  const m = answer.metrics, s = answer.stats, t = answer.timings;
+  const rows = [
+    ["silhouette", null],
+    ["outline Hausdorff (px)", m.silhouette?.outlineHausdorffPx],
+    ["outline mean (px)", m.silhouette?.outlineMeanPx],
+    ["mask Hausdorff (px)", m.silhouette?.hausdorffPx],
+    ["IoU", m.silhouette?.iou],
+    ["mismatched pixels", m.silhouette?.mismatchPx],
+    ["image, depth, normals", null],
+    ["colour RMSE", m.image?.rmse],
+    ["PSNR (dB)", m.image?.psnr],
+    ["diff scale (top of ramp)", m.image?.diffScale],
+    ["depth max (rel.)", m.depth?.maxRel],
+    ["normal mean (deg)", m.normal?.meanDeg],
+    ["normal max (deg)", m.normal?.maxDeg],
+    ["geometry max dist (rel.)", m.geometry?.relMaxDist],
+    ["size", null],
+    ["triangles", s.triangles],
+    ["reference triangles", s.referenceTriangles],
+    ["times (ms)", null],
+    ["surface", t.surfaceMs], ["approximation", t.approxMs], ["raster", t.rasterMs],
+    ["reference", t.referenceMs], ["metrics", t.metricsMs], ["encode", t.encodeMs],
+    ["total", t.totalMs],
+  ];
+  const body = $("metrics").tBodies[0];
+  body.replaceChildren(...rows.map(([name, value]) => {
+    const tr = document.createElement("tr");
+    if (value === null) {
+      tr.className = "group";
+      tr.innerHTML = `<td colspan="2"></td>`;
+      tr.firstChild.textContent = name;
+    } else {
+      tr.innerHTML = "<td></td><td></td>";
+      tr.cells[0].textContent = name;
+      tr.cells[1].textContent = formatNumber(value);
+    }
+    return tr;
+  }));
+}
+
+// ---------------------------------------------------------------- the cage without the surface
+
+// With the surface switched off the server has nothing to draw the cage over, so the page
+// draws the control mesh's edges itself, projected with the camera the answer resolved.
+function drawClientCage(camera) {
+  const canvas = $("cage-canvas");
+  const show = !$("draw-surface").checked && $("draw-cage").checked && state.meshText;
+  canvas.hidden = !show;
+  if (!show) return;
+  const { points, faces } = cageOf(state.meshText);
+  const w = (canvas.width = camera.width), h = (canvas.height = camera.height);
+  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                           a[0] * b[1] - a[1] * b[0]];
+  const unit = (a) => { const l = Math.hypot(...a); return a.map((x) => x / l); };
+  const forward = unit(sub(camera.target, camera.eye));
+  const right = unit(cross(forward, camera.up)), up = cross(right, forward);
+  const f = 1 / Math.tan((camera.fovYDeg * Math.PI) / 360);
+  const project = (p) => {
+    const d = sub(p, camera.eye), z = dot(d, forward);
+    if (camera.projection === "orthographic") {
+      const s = h / camera.orthoHeight;
+      return [w / 2 + dot(d, right) * s, h / 2 - dot(d, up) * s];
+    }
+    return [w / 2 + (dot(d, right) / z) * f * (h / 2), h / 2 - (dot(d, up) / z) * f * (h / 2)];
+  };
+  const ctx = canvas.getContext("2d");
+  ctx.clearRect(0, 0, w, h);
+  ctx.strokeStyle = "#1f3a93";
+  ctx.lineWidth = Math.max(1, w / 400);
+  ctx.beginPath();
+  const projected = points.map(project);
+  for (const face of faces) {
+    face.forEach((v, i) => {
+      const [x, y] = projected[v];
+      if (i === 0) ctx.moveTo(x, y); else ctx.lineTo(x, y);
+    });
+    ctx.closePath();
+  }
+  ctx.stroke();
+  ctx.fillStyle = "#1f3a93";
+  for (const [x, y] of projected) ctx.fillRect(x - 1.5, y - 1.5, 3, 3);
+}
+
+// Points and faces (0-based) of an OBJ text or a JSON mesh.
+function cageOf(mesh) {
+  if (typeof mesh !== "string") {
+    const faces = [];
+    let k = 0;
+    for (const n of mesh.faceVertexCounts || []) {
+      faces.push(mesh.faceVertexIndices.slice(k, k + n));
+      k += n;
+    }
+    return { points: mesh.points || [], faces };
+  }
+  const points = [], faces = [];
+  for (const line of mesh.split(/\r\n|\r|\n/)) {
+    const words = line.trim().split(/\s+/);
+    if (words[0] === "v") points.push(words.slice(1, 4).map(Number));
+    if (words[0] === "f") {
+      faces.push(words.slice(1).map((w) => {
+        const i = parseInt(w, 10);
+        return i < 0 ? points.length + i : i - 1;
+      }));
+    }
+  }
+  return { points, faces };
+}
+
+// ---------------------------------------------------------------- meshes
+
+// The mesh as sent, with the page's scheme and boundary/crease choices applied: for OBJ they
+// replace the file's own tag lines, for the JSON form its fields.
+function wireMesh(source) {
+  const scheme = $("scheme").value, boundary = $("boundary").value;
+  const creaseMethod = $("crease-method").value;
+  if (typeof source !== "string") {
+    const mesh = { ...source, scheme };
+    if (boundary) mesh.interpolateBoundary = boundary;
+    if (creaseMethod) mesh.creaseMethod = creaseMethod;
+    return mesh;
+  }
+  let data = source;
+  if (boundary) {
+    const k = { none: 0, "edge-and-corner": 1, "edge-only": 2 }[boundary];
+    data = data.replace(/^t\s+interpolateboundary\b.*$/gm, "") + `\nt interpolateboundary 1/0/0 ${k}\n`;
+  }
+  if (creaseMethod) {
+    const name = creaseMethod === "chaikin" ? "chaikin" : "normal";
+    data = data.replace(/^t\s+creasemethod\b.*$/gm, "") + `\nt creasemethod 0/0/1 ${name}\n`;
+  }
+  return { format: "obj", data, scheme };
+}
+
+async function useMesh(source, label) {
+  state.full?.abort();
+  state.meshText = source;
+  state.mesh = new UploadedMesh(wireMesh(source));
+  clearErrors();
+  setBusy("uploading the mesh…");
+  try {
+    const info = await state.mesh.upload();
+    $("mesh-info").textContent = `${label}: ${info.vertices} vertices, ${info.faces} faces` +
+        (info.warnings.length ? ` (${info.warnings.length} warnings)` : "");
+    $("mesh-info").title = info.warnings.join("\n");
+  } catch (problem) {
+    setBusy(null);
+    state.mesh = null;
+    $("mesh-info").textContent = "";
+    showError(problem);
+    return;
+  }
+  hideContours();
+  await renderFull();
+}
+
+async function loadExample(name) {
+  const example = state.examples.find((e) => e.name === name);
+  if (!example) return;
+  $("scheme").value = example.scheme;
+  const text = await getText(`/examples/${encodeURIComponent(name)}`);
+  await useMesh(text, example.title);
+}
+
+async function loadFile(file) {
+  const text = await file.text();
+  let source = text;
+  if (/\.json$/i.test(file.name) || /^\s*\{/.test(text)) {
+    try {
+      const parsed = JSON.parse(text);
+      source = parsed.mesh || parsed;  // a whole /v1/render request, or a JSON mesh
+    } catch (error) {
+      showError(new ApiProblem(400, { error: { message: `${file.name} is not JSON: ${error.message}`,
+                                               detail: { field: "mesh" } } }));
+      return;
+    }
+    if (source.format === "obj") {
+      if (source.scheme) $("scheme").value = source.scheme;
+      source = source.data;
+    } else if (source.scheme) {
+      $("scheme").value = source.scheme === "catmullClark" ? "catmull-clark" : source.scheme;
+    }
+  }
+  $("example").value = "";
+  await useMesh(source, file.name);
+}
+
+// ---------------------------------------------------------------- camera
+
+function describeView() {
+  const v = state.view;
+  $("camera-text").textContent = `azimuth ${v.azimuthDeg.toFixed(0)}°, elevation ` +
+      `${v.elevationDeg.toFixed(0)}°` + (v.distance ? `, distance ${v.distance.toFixed(2)} r` : "");
+  $("view").dataset.azimuth = v.azimuthDeg.toFixed(1);
+  $("view").dataset.elevation = v.elevationDeg.toFixed(1);
+}
+
+function bindCamera() {
+  const view = $("view");
+  let last = null;
+  view.addEventListener("pointerdown", (event) => {
+    if (event.button !== 0) return;
+    view.setPointerCapture(event.pointerId);
+    last = [event.clientX, event.clientY];
+    state.dragging = true;
+    state.full?.abort();
+    view.classList.add("dragging");
+  });
+  view.addEventListener("pointermove", (event) => {
+    if (!last) return;
+    const dx = event.clientX - last[0], dy = event.clientY - last[1];
+    if (dx === 0 && dy === 0) return;
+    last = [event.clientX, event.clientY];
+    const v = state.view;
+    v.azimuthDeg = (((v.azimuthDeg - dx * 0.5) % 360) + 540) % 360 - 180;
+    v.elevationDeg = Math.max(-89, Math.min(89, v.elevationDeg + dy * 0.5));
+    describeView();
+    renderPreview();
+  });
+  const end = () => {
+    if (!last) return;
+    last = null;
+    state.dragging = false;
+    view.classList.remove("dragging");
+    state.dragEndedAt = performance.now();
+    renderFull();
+  };
+  view.addEventListener("pointerup", end);
+  view.addEventListener("pointercancel", end);
+  let wheelTimer = null;
+  view.addEventListener("wheel", (event) => {
+    event.preventDefault();
+    const v = state.view;
+    const current = v.distance || 3.5;  // about the default framing at 35 degrees
+    v.distance = Math.max(1.05, Math.min(40, current * Math.pow(1.0015, event.deltaY)));
+    describeView();
+    renderPreview();
+    clearTimeout(wheelTimer);
+    wheelTimer = setTimeout(renderFull, 250);
+  }, { passive: false });
+  view.addEventListener("dblclick", () => {
+    state.view = { ...DEFAULT_VIEW };
+    describeView();
+    renderFull();
+  });
+  // Dropping a file anywhere on the picture loads it.
+  view.addEventListener("dragover", (event) => { event.preventDefault(); view.classList.add("drop"); });
+  view.addEventListener("dragleave", () => view.classList.remove("drop"));
+  view.addEventListener("drop", (event) => {
+    event.preventDefault();
+    view.classList.remove("drop");
+    const file = event.dataTransfer.files[0];
+    if (file) loadFile(file);
+  });
+}
+
+// ---------------------------------------------------------------- controls
+
+function showMethodParams() {
+  const method = $("method").value;
+  for (const group of document.querySelectorAll(".params")) {
+    group.hidden = group.dataset.for !== method;
+  }
+}
+
+function applyLayout() {
+  const slider = document.querySelector("input[name=compare-layout]:checked").value === "slider";
+  document.body.classList.toggle("slider", slider);
+  const on = slider && comparing() && document.body.classList.contains("comparing");
+  $("slider").hidden = !on;
+  $("slider-reference").hidden = !on;
+  $("slider-reference").style.clipPath = `inset(0 0 0 ${$("slider").value}%)`;
+  $("approx-caption").textContent = on ? "approximation (left) | exact reference (right)"
+                                       : "approximation";
+}
+
+function bindControls() {
+  $("example").addEventListener("change", () => loadExample($("example").value));
+  $("upload").addEventListener("change", () => {
+    const file = $("upload").files[0];
+    if (file) loadFile(file);
+  });
+  for (const id of ["scheme", "boundary", "crease-method"]) {
+    $(id).addEventListener("change", () => {
+      if (state.meshText !== null) useMesh(state.meshText, $("mesh-info").textContent.split(":")[0]);
+    });
+  }
+  $("level").addEventListener("input", () => { $("level-value").textContent = $("level").value; });
+  $("method").addEventListener("change", showMethodParams);
+  for (const id of ["method", "level", "engine", "dicing-rate", "contour-mode", "presubdivide",
+                    "draw-surface", "draw-cage", "draw-wireframe", "shading", "size"]) {
+    $(id).addEventListener("change", renderFull);
+  }
+  $("draw-contours").addEventListener("change", () => {
+    if ($("draw-contours").checked) loadContours(); else hideContours();
+  });
+  $("compare").addEventListener("change", async () => {
+    if (!comparing()) document.body.classList.remove("comparing");
+    await renderFull();
+    applyLayout();
+  });
+  for (const radio of document.querySelectorAll("input[name=compare-layout]")) {
+    radio.addEventListener("change", applyLayout);
+  }
+  $("slider").addEventListener("input", applyLayout);
+}
+
+async function start() {
+  showMethodParams();
+  describeView();
+  bindControls();
+  bindCamera();
+  try {
+    state.examples = await getJson("/examples");
+  } catch (problem) {
+    showError(problem);
+    return;
+  }
+  for (const e of state.examples) $("example").add(new Option(e.title, e.name));
+  $("example").add(new Option("(uploaded file)", ""));
+  const first = new URLSearchParams(location.search).get("example") || "torus_creased";
+  $("example").value = first;
+  await loadExample(first);
+}
+
+start();
