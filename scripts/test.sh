@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One command from a fresh Debian 12 machine to every test: installs what is missing, builds,
-# and runs the unit and integration tests (the real server on 127.0.0.1) through CTest.
+# and runs the unit, integration (the real server on 127.0.0.1) and browser tests through CTest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh

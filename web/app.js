@@ -240,20 +240,20 @@ function fillMetrics(answer) {
     ["reference", t.referenceMs], ["metrics", t.metricsMs], ["encode", t.encodeMs],
     ["total", t.totalMs],
   ];
-  const body = $("metrics").tBodies[0];
-  body.replaceChildren(...rows.map(([name, value]) => {
-    const tr = document.createElement("tr");
+  // One small table per group, side by side.
+  const tables = [];
+  for (const [name, value] of rows) {
     if (value === null) {
-      tr.className = "group";
-      tr.innerHTML = `<td colspan="2"></td>`;
-      tr.firstChild.textContent = name;
-    } else {
-      tr.innerHTML = "<td></td><td></td>";
-      tr.cells[0].textContent = name;
-      tr.cells[1].textContent = formatNumber(value);
+      const table = document.createElement("table");
+      table.createCaption().textContent = name;
+      tables.push(table);
+      continue;
     }
-    return tr;
-  }));
+    const tr = tables.at(-1).insertRow();
+    tr.insertCell().textContent = name;
+    tr.insertCell().textContent = formatNumber(value);
+  }
+  $("metrics").replaceChildren(...tables);
 }
 
 // ---------------------------------------------------------------- the cage without the surface

@@ -63,27 +63,31 @@ async function inkFraction(selector) {
   });
 }
 
-// The fraction of pixels that differ between the picture now and `before` (RGBA arrays).
-async function pixels(selector) {
-  return page.$eval(selector, (img) => {
+// Keeps the picture's pixels in the page under `name`, for differingFraction() to compare.
+async function keepPixels(selector, name) {
+  await page.$eval(selector, (img, key) => {
     const canvas = document.createElement("canvas");
     canvas.width = img.naturalWidth;
     canvas.height = img.naturalHeight;
     const ctx = canvas.getContext("2d");
     ctx.drawImage(img, 0, 0);
-    return Array.from(ctx.getImageData(0, 0, canvas.width, canvas.height).data);
-  });
+    (window.kept ??= {})[key] = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
+  }, name);
 }
 
-function differingFraction(a, b) {
-  assert.equal(a.length, b.length, "pictures of different sizes");
-  let differ = 0;
-  for (let i = 0; i < a.length; i += 4) {
-    const d = Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) +
-              Math.abs(a[i + 3] - b[i + 3]);
-    if (d > 24) differ += 1;
-  }
-  return differ / (a.length / 4);
+// The fraction of pixels that differ clearly between two kept pictures of the same size.
+async function differingFraction(a, b) {
+  return page.evaluate(([a, b]) => {
+    const p = window.kept[a], q = window.kept[b];
+    if (p.length !== q.length) throw new Error("pictures of different sizes");
+    let differ = 0;
+    for (let i = 0; i < p.length; i += 4) {
+      const d = Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) +
+                Math.abs(p[i + 2] - q[i + 2]) + Math.abs(p[i + 3] - q[i + 3]);
+      if (d > 24) differ += 1;
+    }
+    return differ / (p.length / 4);
+  }, [a, b]);
 }
 
 // Changes a control the way a person does (the value, then the change event).
@@ -152,18 +156,18 @@ describe("limn's page", () => {
   });
 
   it("changes the picture when the cage is toggled", async () => {
-    const withCage = await pixels("#picture");
+    await keepPixels("#picture", "withCage");
     const n = await set("#draw-cage", false);
     await waitForRenders(n + 1);
-    const without = await pixels("#picture");
-    const changed = differingFraction(withCage, without);
+    await keepPixels("#picture", "without");
+    const changed = await differingFraction("withCage", "without");
     assert.ok(changed > 0.005, `only ${(100 * changed).toFixed(3)}% of the pixels changed`);
   });
 
   it("orbits on a drag: previews while dragging, a new full-size render after", async () => {
     const azimuth = await page.$eval("#view", (el) => Number(el.dataset.azimuth));
     const { renders, previews } = await page.evaluate(() => ({ ...window.limnPage }));
-    const before = await pixels("#picture");
+    await keepPixels("#picture", "beforeDrag");
     const box = await page.locator("#view").boundingBox();
     const x = box.x + box.width / 2, y = box.y + box.height / 2;
     await page.mouse.move(x, y);
@@ -181,7 +185,8 @@ describe("limn's page", () => {
     const after = await page.$eval("#view", (el) => Number(el.dataset.azimuth));
     assert.ok(Math.abs(after - azimuth) > 45, `azimuth ${azimuth} -> ${after}`);
     assert.ok(state.previews > previews, "no preview arrived during the drag");
-    assert.ok(differingFraction(before, await pixels("#picture")) > 0.01, "the view did not turn");
+    await keepPixels("#picture", "afterDrag");
+    assert.ok(await differingFraction("beforeDrag", "afterDrag") > 0.01, "the view did not turn");
     assert.equal(await page.$eval("#picture", (img) => img.naturalWidth), 512);
   });
 

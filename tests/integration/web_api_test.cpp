@@ -89,6 +89,17 @@ TEST_F(WebServer, ServesThePageItsScriptsAndStyle) {
   EXPECT_EQ(get(port(), "/nothing.js").status, 404);
 }
 
+TEST_F(WebServer, OpenApiDocumentDescribesWhatThePageUses) {
+  rapidjson::Document doc = parse(get(port(), "/openapi.json").body);
+  for (const char* path : {"/", "/examples", "/examples/{name}", "/v1/meshes"}) {
+    EXPECT_TRUE(doc["paths"].HasMember(path)) << path;
+  }
+  const auto& schemas = doc["components"]["schemas"];
+  EXPECT_TRUE(schemas["Camera"]["properties"].HasMember("orbit"));
+  EXPECT_TRUE(schemas["Images"]["properties"].HasMember("diff"));
+  EXPECT_TRUE(schemas["Metrics"]["properties"]["image"]["properties"].HasMember("diffScale"));
+}
+
 TEST_F(WebServer, ListsAndServesTheExamples) {
   HttpResponse list = get(port(), "/examples");
   ASSERT_EQ(list.status, 200);
