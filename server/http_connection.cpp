@@ -1,8 +1,11 @@
 #include "server/http_connection.h"
 
+#include <sys/socket.h>
+
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/beast/core/string.hpp>
+#include <cerrno>
 #include <iostream>
 #include <utility>
 
@@ -141,16 +144,35 @@ void Connection::handle() {
                   std::string(message[http::field::authorization]),
                   std::string(message[http::field::origin])};
   // The router may answer from a worker thread: hop back onto this connection's strand.
-  shared_.router.handle(std::move(request),
-                        [self = shared_from_this(), keepAlive](api::Answer answer) {
-                          net::post(self->socket_.get_executor(),
-                                    [self, keepAlive, answer = std::move(answer)]() mutable {
-                                      self->answer(std::move(answer), !keepAlive);
-                                    });
-                        });
+  const unsigned generation = ++handling_;
+  abandon_ = shared_.router.handle(
+      std::move(request), [self = shared_from_this(), keepAlive](api::Answer answer) {
+        net::post(self->socket_.get_executor(),
+                  [self, keepAlive, answer = std::move(answer)]() mutable {
+                    self->answer(std::move(answer), !keepAlive);
+                  });
+      });
+  if (abandon_ && phase_ == Phase::Handling) watchForHangUp(generation);
+}
+
+void Connection::watchForHangUp(unsigned generation) {
+  socket_.async_wait(net::ip::tcp::socket::wait_read, [self = shared_from_this(),
+                                                       generation](error_code ec) {
+    if (ec || generation != self->handling_ || self->phase_ != Phase::Handling) return;
+    char byte;
+    const ssize_t got = ::recv(self->socket_.native_handle(), &byte, 1, MSG_PEEK | MSG_DONTWAIT);
+    if (got > 0) return;  // the next request (pipelined): it waits in the socket for its turn
+    if (got < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) {
+      return self->watchForHangUp(generation);
+    }
+    // End of stream or a reset: nobody is left to read the answer.
+    if (auto abandon = std::move(self->abandon_)) abandon();
+    self->closeNow();
+  });
 }
 
 void Connection::answer(api::Answer answer, bool close) {
+  abandon_ = nullptr;
   if (phase_ == Phase::Closing) return;
   phase_ = Phase::Writing;
   close = close || closeAfterWrite_ || shared_.stopping;

@@ -2,6 +2,10 @@
 // life: read the header, (say 100 Continue), read the body, hand the request to the Router,
 // write the answer, then read the next request (keep-alive) or close.
 //
+// While a request is with the worker pool the connection watches its socket: a client that
+// closes it (a page that aborted the request for a newer camera) gets its job abandoned, so
+// the worker stops instead of finishing a picture nobody will see.
+//
 // Every failure that can still be answered is answered in JSON before the connection closes:
 // malformed HTTP 400, header over its limit 431, body over maxBodyBytes 413, a client too slow
 // to send its request 408. When the server closes after such an answer it lingers (shuts down
@@ -88,6 +92,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void readBody();
   void onBody(boost::system::error_code ec);
   void handle();
+  // While handling: waits for the socket to turn readable, then tells end of stream (the client
+  // went away: abandon the job) from the next request's first bytes (keep waiting for nothing).
+  void watchForHangUp(unsigned generation);
   void answer(api::Answer answer, bool close);
   void onWrite(boost::system::error_code ec);
   // Answers a request that cannot be read any further, then closes.
@@ -113,6 +120,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   size_t bytesIn_ = 0;        // its body
   std::chrono::steady_clock::time_point requestStart_;
   char drainBuffer_[4096];
+  WorkerPool::Abandon abandon_;  // the job of the request being handled, while it runs
+  unsigned handling_ = 0;        // counts handle() calls: a stale watch sees another number
 };
 
 }  // namespace limn::server

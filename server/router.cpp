@@ -1,6 +1,7 @@
 #include "server/router.h"
 
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -95,7 +96,7 @@ Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, Serv
       log_(logLevel),
       started_(std::chrono::steady_clock::now()) {}
 
-void Router::handle(Request request, Reply reply) {
+WorkerPool::Abandon Router::handle(Request request, Reply reply) {
   if (access_.originAllowed(request.origin)) {
     // Every answer to this origin, now or from a worker later, carries the CORS headers.
     reply = [origin = request.origin, reply = std::move(reply)](api::Answer answer) {
@@ -105,13 +106,19 @@ void Router::handle(Request request, Reply reply) {
   }
   std::string_view path = pathOf(request.target);
   if (request.method == "OPTIONS" && routeLabel(path) != "other") {
-    if (auto preflight = access_.preflight(request.origin)) return reply(std::move(*preflight));
+    if (auto preflight = access_.preflight(request.origin)) {
+      reply(std::move(*preflight));
+      return {};
+    }
   }
-  if (auto refusal = access_.refuse(path, request.authorization)) return reply(std::move(*refusal));
-  route(std::move(request), std::move(reply));
+  if (auto refusal = access_.refuse(path, request.authorization)) {
+    reply(std::move(*refusal));
+    return {};
+  }
+  return route(std::move(request), std::move(reply));
 }
 
-void Router::route(Request request, Reply reply) {
+WorkerPool::Abandon Router::route(Request request, Reply reply) {
   const std::string target = request.target;
   std::string_view path = pathOf(target);
   std::vector<std::string> allowed;
@@ -123,7 +130,7 @@ void Router::route(Request request, Reply reply) {
   if (allowed.empty()) {
     reply(api::errorAnswer({404, "not_found", "no such endpoint: " + std::string(path),
                             "{\"path\":" + jsonString(path) + "}"}));
-    return;
+    return {};
   }
   bool methodAllowed = false;
   for (const auto& m : allowed) methodAllowed = methodAllowed || m == request.method;
@@ -136,19 +143,24 @@ void Router::route(Request request, Reply reply) {
          "{\"allow\":" + jsonString(allow) + "}"});
     answer.headers.emplace_back("Allow", allow);
     reply(std::move(answer));
-    return;
+    return {};
   }
 
-  if (asset) return reply(webAsset(*asset));
-  if (path == "/healthz") return reply(healthz());
-  if (path == "/readyz") return reply(readyz());
-  if (path == "/metrics") return reply(metricsAnswer());
-  if (path == "/openapi.json") return reply(jsonAnswer(200, std::string(api::openApiDocument())));
+  std::optional<api::Answer> now;
+  if (asset) now = webAsset(*asset);
+  if (path == "/healthz") now = healthz();
+  if (path == "/readyz") now = readyz();
+  if (path == "/metrics") now = metricsAnswer();
+  if (path == "/openapi.json") now = jsonAnswer(200, std::string(api::openApiDocument()));
+  if (now) {
+    reply(std::move(*now));
+    return {};
+  }
   if (path == "/v1/silhouette") {
     return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
   }
   if (path == "/v1/meshes") return uploadMesh(std::move(request.body), std::move(reply));
-  render(std::move(request.body), std::move(reply));
+  return render(std::move(request.body), std::move(reply));
 }
 
 // The page and the examples: small and built in, answered on the IO thread. no-cache makes a
@@ -163,12 +175,13 @@ api::Answer Router::webAsset(const EmbeddedFile& file) const {
 
 // Parsing a large mesh takes a while: it runs on a worker like a render (same queue, limits and
 // deadline), though it needs no GL context.
-void Router::uploadMesh(std::string body, Reply reply) {
+WorkerPool::Abandon Router::uploadMesh(std::string body, Reply reply) {
   if (!meshes_) {
-    return reply(api::errorAnswer(
+    reply(api::errorAnswer(
         {404, "not_found", "this server keeps no uploaded meshes", "{\"path\":\"/v1/meshes\"}"}));
+    return {};
   }
-  pool_.submit(
+  return pool_.submit(
       [body = std::move(body), limits = limits_, meshes = meshes_](render::pipeline::RenderContext&,
                                                                    const render::CancelToken&) {
         return api::handleMeshUpload(body, limits, *meshes);
@@ -176,8 +189,8 @@ void Router::uploadMesh(std::string body, Reply reply) {
       std::move(reply));
 }
 
-void Router::render(std::string body, Reply reply) {
-  pool_.submit(
+WorkerPool::Abandon Router::render(std::string body, Reply reply) {
+  return pool_.submit(
       [body = std::move(body), limits = limits_, meshes = meshes_](
           render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
         return api::handleRender(body, limits, context, cancel, meshes);
@@ -187,8 +200,8 @@ void Router::render(std::string body, Reply reply) {
 
 // Contours need no GL context, but share the render workers: one queue, one set of limits and
 // deadlines for everything that computes.
-void Router::silhouette(std::string body, std::string accept, Reply reply) {
-  pool_.submit(
+WorkerPool::Abandon Router::silhouette(std::string body, std::string accept, Reply reply) {
+  return pool_.submit(
       [body = std::move(body), accept = std::move(accept), limits = limits_, meshes = meshes_](
           render::pipeline::RenderContext&, const render::CancelToken& cancel) {
         return api::handleSilhouette(body, accept, limits, cancel, meshes);
@@ -261,7 +274,8 @@ api::Answer Router::metricsAnswer() const {
          "# TYPE limn_render_jobs_refused_total counter\n"
       << "limn_render_jobs_refused_total{reason=\"busy\"} " << pool.rejectedBusy << "\n"
       << "limn_render_jobs_refused_total{reason=\"timeout\"} " << pool.timedOut << "\n"
-      << "limn_render_jobs_refused_total{reason=\"shutdown\"} " << pool.cancelled << "\n";
+      << "limn_render_jobs_refused_total{reason=\"shutdown\"} " << pool.cancelled << "\n"
+      << "limn_render_jobs_refused_total{reason=\"abandoned\"} " << pool.abandoned << "\n";
   if (const render::oracle::ReferenceSceneCache* cache = pool_.options().referenceCache) {
     render::oracle::ReferenceSceneCache::Counters c = cache->counters();
     out << "# HELP limn_reference_cache_lookups_total Reference scene lookups, by result.\n"

@@ -51,8 +51,9 @@ class Router {
          render::mesh::MeshCache* meshes = nullptr);
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
-  // the pool's watchdog for renders.
-  void handle(Request request, Reply reply);
+  // the pool's watchdog for renders. For work that went to the pool, returns the handle that
+  // cancels it when the client goes away (WorkerPool::Abandon); else an empty one.
+  WorkerPool::Abandon handle(Request request, Reply reply);
 
   // The label a request's path gets in /metrics: the path when limn serves it, else "other".
   static std::string routeLabel(std::string_view target);
@@ -65,12 +66,12 @@ class Router {
   api::Answer healthz() const;
   api::Answer readyz() const;
   api::Answer metricsAnswer() const;
-  void render(std::string body, Reply reply);
-  void silhouette(std::string body, std::string accept, Reply reply);
-  void uploadMesh(std::string body, Reply reply);
+  WorkerPool::Abandon render(std::string body, Reply reply);
+  WorkerPool::Abandon silhouette(std::string body, std::string accept, Reply reply);
+  WorkerPool::Abandon uploadMesh(std::string body, Reply reply);
   api::Answer webAsset(const EmbeddedFile& file) const;
 
-  void route(Request request, Reply reply);
+  WorkerPool::Abandon route(Request request, Reply reply);
 
   render::pipeline::JobLimits limits_;
   WorkerPool& pool_;

@@ -93,7 +93,7 @@ WorkerPool::~WorkerPool() {
   join();
 }
 
-void WorkerPool::submit(Work work, Reply reply) {
+WorkerPool::Abandon WorkerPool::submit(Work work, Reply reply) {
   api::Answer refusal;
   {
     std::lock_guard lock(mutex_);
@@ -113,10 +113,30 @@ void WorkerPool::submit(Work work, Reply reply) {
       workAvailable_.notify_one();
       // Only an earlier deadline than the watchdog's next one needs to wake it.
       if (job->deadlineEntry == deadlines_.begin()) deadlinesChanged_.notify_one();
-      return;
+      // The pool outlives the connections (HttpServer stops them first); the handle holds the
+      // job weakly so that an answered job is freed at once.
+      return [this, weak = std::weak_ptr<Job>(job)] {
+        if (auto j = weak.lock()) abandon(j);
+      };
     }
   }
   reply(std::move(refusal));
+  return {};
+}
+
+void WorkerPool::abandon(const std::shared_ptr<Job>& job) {
+  Reply reply;
+  {
+    std::lock_guard lock(mutex_);
+    reply = claimLocked(*job);
+    if (!reply) return;  // answered already
+    auto queued = std::find(queue_.begin(), queue_.end(), job);
+    if (queued != queue_.end()) queue_.erase(queued);
+    job->token.cancel();
+    ++abandoned_;
+    jobSettled_.notify_all();
+  }
+  reply(api::errorAnswer({499, "client_closed", "the client closed the connection"}));
 }
 
 // A large job (a reference at 1024^2 allocates about a gigabyte in passes, masks and
@@ -283,6 +303,7 @@ PoolSnapshot WorkerPool::snapshot() const {
   s.rejectedBusy = rejectedBusy_;
   s.timedOut = timedOut_;
   s.cancelled = cancelled_;
+  s.abandoned = abandoned_;
   return s;
 }
 

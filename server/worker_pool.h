@@ -11,6 +11,8 @@
 //  - shutdown: drain() refuses new jobs (503) and waits, up to a deadline, for the queued and
 //    running ones to finish; stop() answers every job still queued or running 503 and cancels
 //    the running ones; joinFor() waits a bounded time for the threads to end.
+//  - abandonment: the handle submit() returns drops a queued job or cancels a running one when
+//    the client that asked for it has gone away (a page that moved the camera again).
 // Whatever happens, a job's reply is called exactly once, from whichever thread settled it
 // (a worker, the watchdog, or the submitter for an immediate refusal).
 #pragma once
@@ -63,6 +65,7 @@ struct PoolSnapshot {
   bool stopping = false;
   size_t renderCount = 0;  // jobs run to their end
   size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
+  size_t abandoned = 0;  // jobs whose client went away before their answer
 };
 
 class WorkerPool {
@@ -77,9 +80,15 @@ class WorkerPool {
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
+  // Cancels one job, if it has not been answered yet: a queued job leaves the queue, a running
+  // one has its token cancelled (the worker stops at its next check). Its reply then gets a
+  // 499 nobody reads. Safe to call from any thread, any number of times, after the pool's end.
+  using Abandon = std::function<void()>;
+
   // Queues `work`; `reply` gets its answer, or the 429/503/504 the pool gives instead.
-  // `work` must not throw (a throw becomes 500 internal anyway).
-  void submit(Work work, Reply reply);
+  // `work` must not throw (a throw becomes 500 internal anyway). The returned handle abandons
+  // the job (empty when the job was refused at once).
+  Abandon submit(Work work, Reply reply);
 
   // Refuses new jobs (503) and waits until every queued and running job has been answered or
   // `deadline` passed; true when none is left.
@@ -106,6 +115,7 @@ class WorkerPool {
   // Marks a job settled under the lock and hands back its reply, or nothing when it was settled
   // already (the watchdog and a worker can race for the same job).
   Reply claimLocked(Job& job);
+  void abandon(const std::shared_ptr<Job>& job);
   int retryAfterSecondsLocked() const;
   // Jobs that ran longer than this return the memory they freed to the system afterwards.
   static constexpr double kTrimAfterSeconds = 0.2;
@@ -130,7 +140,7 @@ class WorkerPool {
   int busyWorkers_ = 0;
   double renderSecondsSum_ = 0;
   size_t renderCount_ = 0;
-  size_t rejectedBusy_ = 0, timedOut_ = 0, cancelled_ = 0;
+  size_t rejectedBusy_ = 0, timedOut_ = 0, cancelled_ = 0, abandoned_ = 0;
 };
 
 }  // namespace limn::server

@@ -7,10 +7,15 @@
 #include <rapidjson/writer.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <functional>
+#include <memory>
 #include <set>
 #include <string>
+#include <thread>
 
 #include "render/image/encode.h"
 #include "tests/integration/http_client.h"
@@ -308,6 +313,60 @@ TEST_F(WebServer, DrawsTheDifferenceFromTheReference) {
   EXPECT_EQ(noReference.status, 400);
   EXPECT_NE(noReference.body.find("needs \\\"reference\\\": true"), std::string::npos)
       << noReference.body;
+}
+
+// A page that moves the camera aborts the request it no longer needs; the server sees the
+// connection close and stops that work: a queued job leaves the queue, a running one is
+// cancelled and its worker freed, long before the job would have finished (about 19 s here).
+TEST(AbandonedRequests, StopTheWorkOfAClientThatWentAway) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  const std::string obj = get(server.port(), "/examples/pawn").body;
+  const std::string slow = R"({"mesh":)" + objMesh(obj) +
+                           R"(,"method":"uniform","params":{"level":6,"metricSupersample":8},)"
+                           R"("camera":{"width":2048,"height":2048},"reference":true})";
+  auto raw = [&](const std::string& body) {
+    return "POST /v1/render HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+           "Content-Length: " +
+           std::to_string(body.size()) + "\r\n\r\n" + body;
+  };
+  auto health = [&] { return parse(get(server.port(), "/healthz").body); };
+  auto abandoned = [&] {
+    const std::string metrics = get(server.port(), "/metrics").body;
+    const std::string key = "limn_render_jobs_refused_total{reason=\"abandoned\"} ";
+    const size_t at = metrics.find(key);
+    return at == std::string::npos ? -1 : std::stoi(metrics.substr(at + key.size()));
+  };
+  auto waitFor = [&](const std::function<bool()>& done) {
+    for (int i = 0; i < 200 && !done(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return done();
+  };
+
+  auto running = std::make_unique<HttpClient>(server.port());
+  running->send(raw(slow));
+  ASSERT_TRUE(waitFor([&] { return health()["busyWorkers"].GetInt() == 1; }));
+  {
+    HttpClient queued(server.port());
+    queued.send(raw(slow));
+    ASSERT_TRUE(waitFor([&] { return health()["queueDepth"].GetInt() == 1; }));
+  }  // closes the connection
+  EXPECT_TRUE(waitFor([&] { return health()["queueDepth"].GetInt() == 0; }));
+  EXPECT_EQ(abandoned(), 1);
+  EXPECT_EQ(health()["busyWorkers"].GetInt(), 1) << "the first job still runs";
+
+  const auto closed = std::chrono::steady_clock::now();
+  running.reset();
+  EXPECT_TRUE(waitFor([&] { return health()["busyWorkers"].GetInt() == 0; }));
+  const double freedAfterS =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - closed).count();
+  EXPECT_EQ(abandoned(), 2);
+  std::printf("worker freed %.2f s after its client closed the connection\n", freedAfterS);
+  // The worker is free for the next request.
+  HttpResponse next = post(server.port(), "/v1/render",
+                           R"({"mesh":)" + objMesh(obj) + R"(,"camera":{"width":64,"height":64}})");
+  EXPECT_EQ(next.status, 200);
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
 }
 
 }  // namespace
