@@ -138,21 +138,24 @@ describe("limn's page", () => {
 
   it("shows more triangles for more iterations, with the cage over the surface", async () => {
     await set("#draw-cage", true);
+    await set("#shading", "flat");  // facets show the iteration count
     let n = await set("#level", 1);
     await waitForRenders(n + 1);
     const one = await triangles();
-    await shot("cage-level-1", page.locator("#approx-panel"));
+    await shot("cage-level-1", page.locator("#view"));
     n = await set("#level", 2);
     await waitForRenders(n + 1);
-    await shot("cage-level-2", page.locator("#approx-panel"));
+    await shot("cage-level-2", page.locator("#view"));
     n = await set("#level", 3);
     await waitForRenders(n + 1);
     const three = await triangles();
-    await shot("cage-level-3", page.locator("#approx-panel"));
+    await shot("cage-level-3", page.locator("#view"));
     // The torus is all quads: each level splits a quad into four, two triangles each.
     assert.equal(one, 96 * 2 * 4);
     assert.equal(three, 96 * 2 * 64);
     assert.match(await page.textContent("#stats"), /12,288 triangles/);
+    n = await set("#shading", "smooth");
+    await waitForRenders(n + 1);
   });
 
   it("changes the picture when the cage is toggled", async () => {
@@ -188,6 +191,63 @@ describe("limn's page", () => {
     await keepPixels("#picture", "afterDrag");
     assert.ok(await differingFraction("beforeDrag", "afterDrag") > 0.01, "the view did not turn");
     assert.equal(await page.$eval("#picture", (img) => img.naturalWidth), 512);
+  });
+
+  it("overlays the contour from /v1/silhouette and draws the cage alone without the surface",
+     async () => {
+    await page.check("#draw-contours");
+    await page.locator("#contours-overlay svg path").first().waitFor({ timeout: 60_000 });
+    const pieces = await page.$$eval("#contours-overlay svg path",
+                                     (paths) => paths.map((p) => p.getAttribute("class")));
+    assert.ok(pieces.includes("visible"), `contour pieces: ${pieces}`);
+    await page.uncheck("#draw-contours");
+    assert.ok(await page.locator("#contours-overlay").isHidden());
+
+    let n = await set("#draw-cage", true);
+    await waitForRenders(n + 1);
+    n = await set("#draw-surface", false);
+    await waitForRenders(n + 1);
+    assert.ok(await page.locator("#cage-canvas").isVisible(), "no cage drawn without the surface");
+    assert.ok(await page.locator("#picture").evaluate((img) => getComputedStyle(img).visibility) ===
+              "hidden");
+    const drawn = await page.$eval("#cage-canvas", (canvas) => {
+      const { data } = canvas.getContext("2d").getImageData(0, 0, canvas.width, canvas.height);
+      let ink = 0;
+      for (let i = 3; i < data.length; i += 4) ink += data[i] > 0;
+      return ink / (data.length / 4);
+    });
+    assert.ok(drawn > 0.005, `the cage covers ${(100 * drawn).toFixed(2)}% of the canvas`);
+    await shot("cage-without-surface", page.locator("#approx-panel"));
+    n = await set("#draw-surface", true);
+    await waitForRenders(n + 1);
+    n = await set("#draw-cage", false);
+    await waitForRenders(n + 1);
+  });
+
+  it("cancels a superseded render on the server too", async () => {
+    const abandoned = async () => {
+      const text = await (await fetch(baseUrl + "/metrics")).text();
+      return Number(text.match(/limn_render_jobs_refused_total\{reason="abandoned"\} (\d+)/)[1]);
+    };
+    const before = await abandoned();
+    // A slow render (the reference at 1024 px), superseded at once by a double-click (reset).
+    await page.selectOption("#size", "1024");
+    await page.check("#compare");
+    await page.waitForTimeout(300);
+    const renders = await page.evaluate(() => window.limnPage.renders);
+    await page.dblclick("#view");
+    await waitForRenders(renders + 1);
+    let after = await abandoned();
+    for (let i = 0; i < 40 && after === before; i++) {
+      await page.waitForTimeout(100);
+      after = await abandoned();
+    }
+    assert.ok(after > before, "the server finished a render nobody waited for");
+    await page.uncheck("#compare");
+    await page.selectOption("#size", "512");
+    await page.waitForFunction(() => document.querySelector("#progress").hidden &&
+                                     document.querySelector("#picture").naturalWidth === 512,
+                               null, { timeout: 60_000 });
   });
 
   it("says what is wrong with an uploaded broken OBJ, next to the mesh controls", async () => {

@@ -2,6 +2,7 @@
 // limn itself, meshes uploaded once and rendered by id (POST /v1/meshes), the orbit camera,
 // and the diff output against the reference. Every example the project ships renders.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <rapidjson/document.h>
 #include <rapidjson/stringbuffer.h>
 #include <rapidjson/writer.h>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <set>
@@ -103,6 +105,63 @@ TEST_F(WebServer, OpenApiDocumentDescribesWhatThePageUses) {
   EXPECT_TRUE(schemas["Camera"]["properties"].HasMember("orbit"));
   EXPECT_TRUE(schemas["Images"]["properties"].HasMember("diff"));
   EXPECT_TRUE(schemas["Metrics"]["properties"]["image"]["properties"].HasMember("diffScale"));
+}
+
+// The new routes' real answers against the document, as server_test does for the others
+// (tests/integration/check_openapi.py: declared statuses and media types, strict schemas).
+TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
+  struct Exchange {
+    const char* method;
+    std::string path;        // as requested
+    const char* documented;  // the document's path (template)
+    std::string body;
+  };
+  const std::string cube = objMesh(example("cube"));
+  const std::string id = upload(cube);
+  const std::string big = objMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\n" + std::string(40000, '#') +
+                                  "\nf 1 2 3\n" + [] {
+                                    std::string v;
+                                    for (int i = 0; i < 2000; ++i) v += "v 1 2 3\n";
+                                    return v;
+                                  }());
+  const std::vector<Exchange> exchanges = {
+      {"GET", "/", "/", ""},
+      {"GET", "/examples", "/examples", ""},
+      {"GET", "/examples/pawn", "/examples/{name}", ""},
+      {"GET", "/examples/teapot", "/examples/{name}", ""},
+      {"POST", "/examples", "/examples", ""},
+      {"POST", "/v1/meshes", "/v1/meshes", R"({"mesh":)" + cube + "}"},
+      {"POST", "/v1/meshes", "/v1/meshes", R"({"mesh":{"id":"x"}})"},
+      {"POST", "/v1/meshes", "/v1/meshes", R"({"mesh":)" + objMesh("v 0 0 0\nf 1 2 3\n") + "}"},
+      {"POST", "/v1/meshes", "/v1/meshes", R"({"mesh":)" + big + "}"},
+      {"GET", "/v1/meshes", "/v1/meshes", ""},
+      {"POST", "/v1/render", "/v1/render",
+       R"({"mesh":{"id":")" + id +
+           R"("},"method":"uniform","outputs":["color","diff"],"reference":true,)"
+           R"("camera":{"orbit":{"azimuthDeg":30,"elevationDeg":20,"distance":4},"width":48,"height":48}})"},
+      {"POST", "/v1/render", "/v1/render", R"({"mesh":{"id":"feed"}})"},
+      {"POST", "/v1/silhouette", "/v1/silhouette", R"({"mesh":{"id":"feed"}})"},
+  };
+  const std::string folder = writeTempFile("", "");
+  std::remove(folder.c_str());
+  ASSERT_EQ(::mkdir(folder.c_str(), 0700), 0);
+  std::set<int> statuses;
+  for (size_t i = 0; i < exchanges.size(); ++i) {
+    const Exchange& e = exchanges[i];
+    HttpResponse r = HttpClient(port()).request(e.method, e.path, e.body);
+    statuses.insert(r.status);
+    const std::string name = folder + "/" + std::to_string(100 + i);
+    std::ofstream(name + ".meta") << e.method << " " << e.documented << " " << r.status << " "
+                                  << r.header("Content-Type");
+    std::ofstream(name + ".body", std::ios::binary) << r.body;
+  }
+  CommandResult check =
+      runCommand("/usr/bin/python3 '" LIMN_SOURCE_DIR
+                 "/tests/integration/check_openapi.py' '" LIMN_SOURCE_DIR "/api/openapi.json' '" +
+                 folder + "'");
+  runCommand("rm -rf '" + folder + "'");
+  EXPECT_EQ(check.status, 0) << check.output;
+  EXPECT_EQ(statuses, (std::set<int>{200, 400, 404, 405, 413, 422})) << "the exchanges cover these";
 }
 
 TEST_F(WebServer, ListsAndServesTheExamples) {
