@@ -2,10 +2,10 @@
 // limn itself, meshes uploaded once and rendered by id (POST /v1/meshes), the orbit camera,
 // and the diff output against the reference. Every example the project ships renders.
 #include <gtest/gtest.h>
-#include <sys/stat.h>
 #include <rapidjson/document.h>
 #include <rapidjson/stringbuffer.h>
 #include <rapidjson/writer.h>
+#include <sys/stat.h>
 
 #include <array>
 #include <chrono>
@@ -118,12 +118,12 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
   };
   const std::string cube = objMesh(example("cube"));
   const std::string id = upload(cube);
-  const std::string big = objMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\n" + std::string(40000, '#') +
-                                  "\nf 1 2 3\n" + [] {
-                                    std::string v;
-                                    for (int i = 0; i < 2000; ++i) v += "v 1 2 3\n";
-                                    return v;
-                                  }());
+  const std::string big =
+      objMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\n" + std::string(40000, '#') + "\nf 1 2 3\n" + [] {
+        std::string v;
+        for (int i = 0; i < 2000; ++i) v += "v 1 2 3\n";
+        return v;
+      }());
   const std::vector<Exchange> exchanges = {
       {"GET", "/", "/", ""},
       {"GET", "/examples", "/examples", ""},
