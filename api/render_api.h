@@ -42,6 +42,14 @@ Answer handleRender(std::string_view body, const render::pipeline::JobLimits& li
                     render::pipeline::RenderContext& context, const render::CancelToken& cancel,
                     render::mesh::MeshCache* meshes = nullptr);
 
+// POST /v1/tessellate: the body of a /v1/render request; answers the approximation's mesh
+// (positions, limit normals, triangles) as GLB, PLY or OBJ by `accept` (api/mesh_export.h),
+// 406 not_acceptable when the header allows none. Never throws.
+Answer handleTessellate(std::string_view body, std::string_view accept,
+                        const render::pipeline::JobLimits& limits,
+                        const render::CancelToken& cancel,
+                        render::mesh::MeshCache* meshes = nullptr);
+
 // POST /v1/meshes: {"mesh": {...}} (either form) is read, validated and kept in `meshes`;
 // answers {"id", "vertices", "faces", "scheme", "bytes", "warnings"}. A mesh larger than the
 // whole cache is a 413 naming meshCacheBytes. Never throws.

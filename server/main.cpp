@@ -44,7 +44,9 @@ Usage:
       on stdout. SIGINT or SIGTERM shut it down cleanly (exit status 0).
       Endpoints: POST /v1/render (images and metrics), POST /v1/silhouette (the contour
       curves of the limit surface as JSON polylines or SVG, pieces marked visible or hidden),
-      GET /healthz, /readyz, /metrics, /openapi.json.
+      POST /v1/meshes (a mesh kept for later requests by id), POST /v1/tessellate (the
+      approximation as glTF, PLY or OBJ), GET / (the web page: open it in a browser),
+      /examples, /healthz, /readyz, /metrics, /openapi.json.
 
   limn render REQUEST.json --out DIR [--config FILE]
       Runs one /v1/render request body through the engine without HTTP and writes

@@ -25,9 +25,9 @@ struct Route {
 
 // Every (path, method) limn answers; a known path with another method is a 405 listing these.
 constexpr Route kRoutes[] = {
-    {"/healthz", "GET"},      {"/readyz", "GET"},     {"/metrics", "GET"},
-    {"/openapi.json", "GET"}, {"/v1/render", "POST"}, {"/v1/silhouette", "POST"},
-    {"/v1/meshes", "POST"},
+    {"/healthz", "GET"},      {"/readyz", "GET"},         {"/metrics", "GET"},
+    {"/openapi.json", "GET"}, {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
+    {"/v1/meshes", "POST"},   {"/v1/tessellate", "POST"},
 };
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
@@ -160,6 +160,9 @@ WorkerPool::Abandon Router::route(Request request, Reply reply) {
     return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
   }
   if (path == "/v1/meshes") return uploadMesh(std::move(request.body), std::move(reply));
+  if (path == "/v1/tessellate") {
+    return tessellate(std::move(request.body), std::move(request.accept), std::move(reply));
+  }
   return render(std::move(request.body), std::move(reply));
 }
 
@@ -185,6 +188,17 @@ WorkerPool::Abandon Router::uploadMesh(std::string body, Reply reply) {
       [body = std::move(body), limits = limits_, meshes = meshes_](render::pipeline::RenderContext&,
                                                                    const render::CancelToken&) {
         return api::handleMeshUpload(body, limits, *meshes);
+      },
+      std::move(reply));
+}
+
+// The approximation's mesh for a client that draws it itself: the method's work without the
+// raster, on the same workers.
+WorkerPool::Abandon Router::tessellate(std::string body, std::string accept, Reply reply) {
+  return pool_.submit(
+      [body = std::move(body), accept = std::move(accept), limits = limits_, meshes = meshes_](
+          render::pipeline::RenderContext&, const render::CancelToken& cancel) {
+        return api::handleTessellate(body, accept, limits, cancel, meshes);
       },
       std::move(reply));
 }

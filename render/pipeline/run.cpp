@@ -6,6 +6,7 @@
 #include "render/normalmap/mapped_cage.h"
 #include "render/normalmap/normal_atlas.h"
 #include "render/oracle/reference.h"
+#include "render/pipeline/approximation.h"
 #include "render/pipeline/job_checks.h"
 #include "render/pipeline/render_job.h"
 #include "render/pipeline/silhouette_build.h"
@@ -186,6 +187,50 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
 }
 
 }  // namespace
+
+Approximation approximate(const RenderJob& job, const JobLimits& limits,
+                          const CancelToken& cancel) {
+  Stopwatch clock, total;
+  if (job.method == Method::Limit) {
+    badParameter("method",
+                 "\"limit\" is the ray-cast reference: it has no mesh; choose a method that "
+                 "tessellates (coarse, uniform, adaptive, silhouette)");
+  }
+  checkJob(job, limits);
+  mesh::validateMesh(job.mesh, limits.mesh);
+  cancel.check();
+  const subdiv::LimitSurface surface(job.mesh, cancel);
+  Approximation out{.mesh = {},
+                    .camera = resolveCamera(job.camera, surface.bounds()),
+                    .stats = {},
+                    .timings = {},
+                    .warnings = {}};
+  out.timings.surfaceMs = clock.lapMs();
+  out.stats.controlVertices = job.mesh.vertexCount();
+  out.stats.controlFaces = job.mesh.faceCount();
+  cancel.check();
+  if (job.method == Method::Silhouette) {
+    RenderResult scratch{.images = {},
+                         .referenceImages = {},
+                         .metrics = {},
+                         .stats = {},
+                         .timings = {},
+                         .warnings = {},
+                         .camera = out.camera};
+    std::unique_ptr<subdiv::LimitSurface> presubdivided;
+    out.mesh = runSilhouette(job, limits, surface, out.camera, cancel, presubdivided, scratch).mesh;
+    out.stats.silhouette = scratch.stats.silhouette;
+    out.stats.presubdivided = scratch.stats.presubdivided;
+    out.warnings = std::move(scratch.warnings);
+  } else {
+    out.mesh = approximate(job, limits, surface, out.camera, cancel);
+  }
+  out.stats.triangles = out.mesh.triangleCount();
+  out.stats.vertices = out.mesh.vertexCount();
+  out.timings.approxMs = clock.lapMs();
+  out.timings.totalMs = total.lapMs();
+  return out;
+}
 
 const char* methodName(Method method) {
   switch (method) {

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <memory>
@@ -115,6 +116,7 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
     std::string path;        // as requested
     const char* documented;  // the document's path (template)
     std::string body;
+    Headers headers = {};
   };
   const std::string cube = objMesh(example("cube"));
   const std::string id = upload(cube);
@@ -140,6 +142,24 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
            R"("},"method":"uniform","outputs":["color","diff"],"reference":true,)"
            R"("camera":{"orbit":{"azimuthDeg":30,"elevationDeg":20,"distance":4},"width":48,"height":48}})"},
       {"POST", "/v1/render", "/v1/render", R"({"mesh":{"id":"feed"}})"},
+      {"POST", "/v1/tessellate", "/v1/tessellate", R"({"mesh":{"id":")" + id + R"("}})"},
+      {"POST",
+       "/v1/tessellate",
+       "/v1/tessellate",
+       R"({"mesh":{"id":")" + id + R"("}})",
+       {{"Accept", "application/x-ply"}}},
+      {"POST",
+       "/v1/tessellate",
+       "/v1/tessellate",
+       R"({"mesh":{"id":")" + id + R"("}})",
+       {{"Accept", "text/plain"}}},
+      {"POST",
+       "/v1/tessellate",
+       "/v1/tessellate",
+       R"({"mesh":{"id":")" + id + R"("}})",
+       {{"Accept", "image/png"}}},
+      {"POST", "/v1/tessellate", "/v1/tessellate",
+       R"({"mesh":{"id":")" + id + R"("},"method":"limit"})"},
       {"POST", "/v1/silhouette", "/v1/silhouette", R"({"mesh":{"id":"feed"}})"},
   };
   const std::string folder = writeTempFile("", "");
@@ -148,7 +168,7 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
   std::set<int> statuses;
   for (size_t i = 0; i < exchanges.size(); ++i) {
     const Exchange& e = exchanges[i];
-    HttpResponse r = HttpClient(port()).request(e.method, e.path, e.body);
+    HttpResponse r = HttpClient(port()).request(e.method, e.path, e.body, e.headers);
     statuses.insert(r.status);
     const std::string name = folder + "/" + std::to_string(100 + i);
     std::ofstream(name + ".meta") << e.method << " " << e.documented << " " << r.status << " "
@@ -161,7 +181,8 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
                  folder + "'");
   runCommand("rm -rf '" + folder + "'");
   EXPECT_EQ(check.status, 0) << check.output;
-  EXPECT_EQ(statuses, (std::set<int>{200, 400, 404, 405, 413, 422})) << "the exchanges cover these";
+  EXPECT_EQ(statuses, (std::set<int>{200, 400, 404, 405, 406, 413, 422}))
+      << "the exchanges cover these";
 }
 
 TEST_F(WebServer, ListsAndServesTheExamples) {
@@ -372,6 +393,102 @@ TEST_F(WebServer, DrawsTheDifferenceFromTheReference) {
   EXPECT_EQ(noReference.status, 400);
   EXPECT_NE(noReference.body.find("needs \\\"reference\\\": true"), std::string::npos)
       << noReference.body;
+}
+
+uint32_t u32(const std::string& bytes, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, bytes.data() + at, 4);
+  return v;  // little-endian, like the machines this runs on
+}
+
+// POST /v1/tessellate: the approximation as GLB (default), PLY or OBJ, the same triangles a
+// render of the same request counts, with a normal per vertex.
+TEST_F(WebServer, AnswersTheApproximationsMesh) {
+  const std::string request = R"({"mesh":)" + objMesh(example("torus_creased")) +
+                              R"(,"method":"uniform","params":{"level":2}})";
+  HttpResponse rendered = post(port(), "/v1/render", request);
+  const int64_t triangles = parse(rendered.body)["stats"]["triangles"].GetInt64();
+  ASSERT_EQ(triangles, 96 * 2 * 16);
+
+  HttpResponse glb = post(port(), "/v1/tessellate", request);
+  ASSERT_EQ(glb.status, 200) << glb.body.substr(0, 300);
+  EXPECT_EQ(glb.header("Content-Type"), "model/gltf-binary");
+  EXPECT_EQ(glb.header("X-Limn-Triangles"), std::to_string(triangles));
+  ASSERT_GT(glb.body.size(), 28u);
+  EXPECT_EQ(glb.body.substr(0, 4), "glTF");
+  EXPECT_EQ(u32(glb.body, 4), 2u);
+  EXPECT_EQ(u32(glb.body, 8), glb.body.size());
+  const uint32_t jsonLength = u32(glb.body, 12);
+  EXPECT_EQ(jsonLength % 4, 0u);
+  EXPECT_EQ(glb.body.substr(16, 4), "JSON");
+  rapidjson::Document gltf = parse(glb.body.substr(20, jsonLength));
+  ASSERT_FALSE(gltf.HasParseError());
+  EXPECT_STREQ(gltf["asset"]["version"].GetString(), "2.0");
+  EXPECT_EQ(gltf["asset"]["extras"]["stats"]["triangles"].GetInt64(), triangles);
+  const auto& primitive = gltf["meshes"][0]["primitives"][0];
+  const auto& accessors = gltf["accessors"];
+  const int vertices = accessors[primitive["attributes"]["POSITION"].GetInt()]["count"].GetInt();
+  EXPECT_EQ(accessors[primitive["attributes"]["NORMAL"].GetInt()]["count"].GetInt(), vertices);
+  EXPECT_EQ(accessors[primitive["indices"].GetInt()]["count"].GetInt64(), 3 * triangles);
+  const size_t binAt = 20 + jsonLength;
+  EXPECT_EQ(glb.body.substr(binAt + 4, 4), std::string("BIN\0", 4));
+  EXPECT_EQ(u32(glb.body, binAt), gltf["buffers"][0]["byteLength"].GetUint());
+  EXPECT_EQ(u32(glb.body, binAt), vertices * 24u + triangles * 12u);
+  // Every index names a vertex; every normal is unit length.
+  const size_t indicesAt = binAt + 8 + vertices * 24u;
+  for (int64_t i = 0; i < 3 * triangles; ++i) {
+    ASSERT_LT(u32(glb.body, indicesAt + 4 * i), static_cast<uint32_t>(vertices));
+  }
+  for (int i = 0; i < vertices; ++i) {
+    float n[3];
+    std::memcpy(n, glb.body.data() + binAt + 8 + vertices * 12u + 12u * i, 12);
+    ASSERT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0, 1e-4) << i;
+  }
+
+  HttpResponse ply = post(port(), "/v1/tessellate", request, {{"Accept", "application/x-ply"}});
+  ASSERT_EQ(ply.status, 200);
+  EXPECT_EQ(ply.header("Content-Type"), "application/x-ply");
+  EXPECT_EQ(ply.body.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  EXPECT_NE(ply.body.find("element vertex " + std::to_string(vertices) + "\n"), std::string::npos);
+  EXPECT_NE(ply.body.find("property float nx\n"), std::string::npos);
+  EXPECT_NE(ply.body.find("element face " + std::to_string(triangles) + "\n"), std::string::npos);
+  const size_t header = ply.body.find("end_header\n") + 11;
+  EXPECT_EQ(ply.body.size() - header, vertices * 24u + triangles * 13u);
+
+  // The OBJ is one limn reads back: the same counts as a bilinear mesh (the cube refined once:
+  // small enough for this server's mesh cache).
+  HttpResponse obj = post(
+      port(), "/v1/tessellate",
+      R"({"mesh":)" + objMesh(example("cube")) + R"(,"method":"uniform","params":{"level":1}})",
+      {{"Accept", "text/plain"}});
+  ASSERT_EQ(obj.status, 200);
+  EXPECT_NE(obj.body.find("\nvn "), std::string::npos);
+  HttpResponse again =
+      post(port(), "/v1/meshes", R"({"mesh":)" + objMesh(obj.body, "bilinear") + "}");
+  ASSERT_EQ(again.status, 200) << again.body;
+  EXPECT_EQ(parse(again.body)["vertices"].GetInt(), 26);
+  EXPECT_EQ(parse(again.body)["faces"].GetInt(), 48);
+  EXPECT_EQ(obj.header("X-Limn-Triangles"), "48");
+
+  // Adaptive depends on the camera: the orbit and size are honoured.
+  const std::string adaptive = R"({"mesh":)" + objMesh(example("pawn")) +
+                               R"(,"method":"adaptive","params":{"dicingRate":4},"camera":)";
+  HttpResponse small = post(port(), "/v1/tessellate", adaptive + R"({"width":128,"height":128}})");
+  HttpResponse large =
+      post(port(), "/v1/tessellate", adaptive + R"({"width":1024,"height":1024}})");
+  EXPECT_LT(std::stoll(small.header("X-Limn-Triangles")),
+            std::stoll(large.header("X-Limn-Triangles")));
+
+  HttpResponse png = post(port(), "/v1/tessellate", request, {{"Accept", "image/png"}});
+  EXPECT_EQ(png.status, 406);
+  EXPECT_STREQ(parse(png.body)["error"]["code"].GetString(), "not_acceptable");
+  HttpResponse limit = post(port(), "/v1/tessellate",
+                            R"({"mesh":)" + objMesh(example("cube")) + R"(,"method":"limit"})");
+  EXPECT_EQ(limit.status, 400);
+  EXPECT_STREQ(parse(limit.body)["error"]["detail"]["field"].GetString(), "method");
+  HttpResponse broken =
+      post(port(), "/v1/tessellate", R"({"mesh":)" + objMesh("v 0 0 0\nf 1 2 3\n") + "}");
+  EXPECT_EQ(broken.status, 422);
 }
 
 // A page that moves the camera aborts the request it no longer needs; the server sees the

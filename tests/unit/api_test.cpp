@@ -13,6 +13,7 @@
 #include "api/base64.h"
 #include "api/config.h"
 #include "api/json_mesh_reader.h"
+#include "api/mesh_export.h"
 #include "api/obj_reader.h"
 #include "api/openapi.h"
 #include "api/render_api.h"
@@ -1217,6 +1218,48 @@ TEST(RenderRequest, MeshByIdComesFromTheCache) {
   expectError(extra, 400, "invalid_request");
   EXPECT_EQ(detailMember(extra, "field"), "mesh.format");
   expectError(error(R"({"mesh": {"id": 7}})", &cache), 400, "invalid_request");
+}
+
+}  // namespace
+
+namespace {
+
+TEST(MeshExport, AcceptChoosesTheFormat) {
+  using api::MeshFormat;
+  EXPECT_EQ(api::chooseMeshFormat(""), MeshFormat::Glb);
+  EXPECT_EQ(api::chooseMeshFormat("*/*"), MeshFormat::Glb);
+  EXPECT_EQ(api::chooseMeshFormat("application/x-ply"), MeshFormat::Ply);
+  EXPECT_EQ(api::chooseMeshFormat("model/ply"), MeshFormat::Ply);
+  EXPECT_EQ(api::chooseMeshFormat("Text/Plain"), MeshFormat::Obj);
+  EXPECT_EQ(api::chooseMeshFormat("model/gltf-binary;q=0.4, text/plain;q=0.8, */*;q=0.1"),
+            MeshFormat::Obj);
+  EXPECT_EQ(api::chooseMeshFormat("text/html, */*;q=0.5"), MeshFormat::Glb);
+  EXPECT_FALSE(api::chooseMeshFormat("image/png").has_value());
+  EXPECT_FALSE(api::chooseMeshFormat("text/plain;q=0").has_value());
+}
+
+TEST(MeshExport, ObjAndPlyCarryEveryVertexNormalAndTriangle) {
+  render::tessellate::TriangleMesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  mesh.normals.assign(4, {0, 0, 1});
+  mesh.indices = {0, 1, 2, 2, 1, 3};
+  const std::string obj = api::writeObjMesh(mesh, {"two triangles"});
+  EXPECT_EQ(obj.rfind("# two triangles\nv 0 0 0\n", 0), 0u);
+  EXPECT_TRUE(contains(obj, "vn 0 0 1\n"));
+  EXPECT_TRUE(contains(obj, "f 1//1 2//2 3//3\nf 3//3 2//2 4//4\n"));
+  const std::string ply = api::writePly(mesh, {"x"});
+  EXPECT_TRUE(contains(ply, "comment x\nelement vertex 4\n"));
+  EXPECT_TRUE(contains(ply, "element face 2\n"));
+  EXPECT_EQ(ply.size() - (ply.find("end_header\n") + 11), 4u * 24 + 2u * 13);
+  const std::string glb = api::writeGlb(mesh, R"({"note":1})");
+  EXPECT_EQ(glb.substr(0, 4), "glTF");
+  EXPECT_EQ(glb.size() % 4, 0u);
+  EXPECT_TRUE(contains(glb, R"("extras":{"note":1})"));
+  EXPECT_TRUE(contains(glb, R"("min":[0,0,0],"max":[1,1,0])"));
+  // No triangles: a valid file with an empty scene.
+  const std::string empty = api::writeGlb({}, "");
+  EXPECT_TRUE(contains(empty, R"("scenes":[{"nodes":[]}])"));
+  EXPECT_FALSE(contains(empty, "BIN"));
 }
 
 }  // namespace
