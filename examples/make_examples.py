@@ -140,8 +140,10 @@ EXAMPLES = [
     {"name": "cube", "title": "Cube", "scheme": "catmull-clark"},
     {"name": "torus_creased", "title": "Creased torus", "scheme": "catmull-clark"},
     {"name": "icosahedron", "title": "Loop icosahedron", "scheme": "loop"},
-    {"name": "pawn", "title": "Pawn (revolved profile)", "scheme": "catmull-clark"},
-    {"name": "grid", "title": "Open grid with a boundary", "scheme": "catmull-clark"},
+    {"name": "pawn", "title": "Pawn (revolved profile)", "scheme": "catmull-clark",
+     "orbit": {"azimuthDeg": 30, "elevationDeg": 15}},
+    {"name": "grid", "title": "Open grid with a boundary", "scheme": "catmull-clark",
+     "orbit": {"azimuthDeg": 20, "elevationDeg": 50}},
 ]
 
 if __name__ == "__main__":

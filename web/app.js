@@ -6,6 +6,7 @@ import { ApiProblem, UploadedMesh, getJson, getText, post } from "/api.js";
 
 const $ = (id) => document.getElementById(id);
 const DEFAULT_VIEW = { azimuthDeg: 30, elevationDeg: 20, distance: null };
+let firstView = DEFAULT_VIEW;  // the example's own view (examples.json "orbit"), else DEFAULT_VIEW
 const PREVIEW_DIVISOR = 4;  // drag previews render at a quarter of the size in each direction
 
 // What the browser tests (and a curious person in the console) can read.
@@ -42,6 +43,7 @@ function showError(problem) {
                                              : `Could not reach limn: ${problem.message}`;
   $(slot).textContent = text;
   $(slot).hidden = false;
+  $(slot).scrollIntoView({ block: "nearest" });
 }
 
 function setBusy(text) {
@@ -377,6 +379,9 @@ async function loadExample(name) {
   const example = state.examples.find((e) => e.name === name);
   if (!example) return;
   $("scheme").value = example.scheme;
+  firstView = { ...DEFAULT_VIEW, ...(example.orbit || {}) };
+  state.view = { ...firstView };
+  describeView();
   const text = await getText(`/examples/${encodeURIComponent(name)}`);
   await useMesh(text, example.title);
 }
@@ -458,7 +463,7 @@ function bindCamera() {
     wheelTimer = setTimeout(renderFull, 250);
   }, { passive: false });
   view.addEventListener("dblclick", () => {
-    state.view = { ...DEFAULT_VIEW };
+    state.view = { ...firstView };
     describeView();
     renderFull();
   });
