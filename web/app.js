@@ -426,15 +426,17 @@ function bindCamera() {
     if (event.button !== 0) return;
     view.setPointerCapture(event.pointerId);
     last = [event.clientX, event.clientY];
-    state.dragging = true;
-    state.full?.abort();
-    view.classList.add("dragging");
   });
   view.addEventListener("pointermove", (event) => {
     if (!last) return;
     const dx = event.clientX - last[0], dy = event.clientY - last[1];
     if (dx === 0 && dy === 0) return;
     last = [event.clientX, event.clientY];
+    if (!state.dragging) {  // the first move: a drag, and the full picture in flight is stale
+      state.dragging = true;
+      state.full?.abort();
+      view.classList.add("dragging");
+    }
     const v = state.view;
     v.azimuthDeg = (((v.azimuthDeg - dx * 0.5) % 360) + 540) % 360 - 180;
     v.elevationDeg = Math.max(-89, Math.min(89, v.elevationDeg + dy * 0.5));
@@ -444,6 +446,7 @@ function bindCamera() {
   const end = () => {
     if (!last) return;
     last = null;
+    if (!state.dragging) return;  // a click, not a drag
     state.dragging = false;
     view.classList.remove("dragging");
     state.dragEndedAt = performance.now();
