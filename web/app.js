@@ -16,6 +16,7 @@ const page = (window.limnPage = {
   firstPictureMs: null,  // performance.now() when the first full-size picture was shown
   dragToFullMs: null,    // from the last drag's end to its full-size picture
   lastAnswer: null,
+  get busy() { return state.full !== null; },  // a full-size render is in flight
 });
 
 const state = {

@@ -41,9 +41,12 @@ async function shot(name, locator = page) {
   await locator.screenshot({ path: path.join(artifacts, `${name}.png`) });
 }
 
-// Waits until the page has shown `n` full-size pictures in all.
+// Waits until the page has shown `n` full-size pictures in all and has none in flight, so
+// that what it shows is the answer to the latest settings (a render that was already on its
+// way when a control changed may land first and count).
 async function waitForRenders(n) {
-  await page.waitForFunction((k) => window.limnPage.renders >= k, n, { timeout: 120_000 });
+  await page.waitForFunction((k) => window.limnPage.renders >= k && !window.limnPage.busy, n,
+                             { timeout: 120_000 });
 }
 
 // The fraction of an <img>'s pixels that show something: opaque and not near white.
