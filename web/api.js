@@ -52,6 +52,18 @@ export async function post(path, body, { signal, accept } = {}) {
   return answer;
 }
 
+// The same for a binary answer (a mesh from /v1/tessellate): an ArrayBuffer.
+export async function postBinary(path, body, { signal, accept } = {}) {
+  const headers = { "Content-Type": "application/json" };
+  if (accept) headers.Accept = accept;
+  const response = await fetch(path, { method: "POST", headers, body: JSON.stringify(body), signal });
+  if (!response.ok) {
+    throw new ApiProblem(response.status, await response.json().catch(() => null),
+                         Number(response.headers.get("Retry-After")) || 1);
+  }
+  return response.arrayBuffer();
+}
+
 export async function getJson(path) {
   const response = await fetch(path);
   if (!response.ok) throw new ApiProblem(response.status, await response.json().catch(() => null));

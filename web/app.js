@@ -1,22 +1,39 @@
 // limn's page: pick or upload a mesh, choose a method and what to draw, orbit the camera, and
 // compare the approximation with the exact reference. Every picture comes from the server
-// (POST /v1/render); while the camera is dragged, small renders keep the view moving and the
-// full-size one follows when the drag ends. See docs/web.md.
-import { ApiProblem, UploadedMesh, getJson, getText, post } from "/api.js";
+// (POST /v1/render); while the camera is dragged the page draws the approximation's triangles
+// itself (POST /v1/tessellate, WebGL 2: glview.js), or, without WebGL or before they arrive,
+// shows small renders, and the full-size picture follows when the drag ends. See docs/web.md.
+import { ApiProblem, UploadedMesh, getJson, getText, post, postBinary } from "/api.js";
+import { MeshView, parseGlb } from "/glview.js";
 
 const $ = (id) => document.getElementById(id);
 const DEFAULT_VIEW = { azimuthDeg: 30, elevationDeg: 20, distance: null };
 let firstView = DEFAULT_VIEW;  // the example's own view (examples.json "orbit"), else DEFAULT_VIEW
 const PREVIEW_DIVISOR = 4;  // drag previews render at a quarter of the size in each direction
+const LOCAL_MAX_TRIANGLES = 400_000;  // larger approximations are previewed by small renders
 
 // What the browser tests (and a curious person in the console) can read.
 const page = (window.limnPage = {
   renders: 0,            // full-size pictures shown
-  previews: 0,           // drag previews shown
+  previews: 0,           // drag previews shown (small renders from the server)
+  localFrames: 0,        // drag frames the page drew itself (WebGL)
   firstPictureMs: null,  // performance.now() when the first full-size picture was shown
   dragToFullMs: null,    // from the last drag's end to its full-size picture
   lastAnswer: null,
   get busy() { return state.full !== null; },  // a full-size render is in flight
+  // The local view holds the approximation the settings ask for (drags will draw it).
+  get localReady() {
+    return Boolean(state.glView?.ready && state.glView.key === tessellationKey() && state.frame);
+  },
+  // The local view at the current camera, drawn now, as a PNG data URL (tests compare it with
+  // the server's picture of the same camera).
+  localSnapshot() {
+    state.glView.draw(orbitCamera(), fullSize(), {
+      surface: $("draw-surface").checked, cage: $("draw-cage").checked,
+      flat: $("shading").value === "flat",
+    });
+    return $("gl-canvas").toDataURL("image/png");
+  },
 });
 
 const state = {
@@ -27,6 +44,9 @@ const state = {
   full: null,           // AbortController of the full-size render in flight
   preview: { busy: false, again: false },
   dragEndedAt: null,
+  frame: null,          // {target, radius, fovYDeg} of the mesh, from the last answer's camera
+  glView: null,         // MeshView, when the browser has WebGL 2
+  tessellation: null,   // AbortController of the POST /v1/tessellate in flight
 };
 
 // ---------------------------------------------------------------- errors next to controls
@@ -106,6 +126,7 @@ async function renderFull() {
   state.full?.abort();
   const controller = (state.full = new AbortController());
   const compare = comparing();
+  const sentView = { ...state.view };
   setBusy(compare ? "rendering and ray-casting the reference…" : "rendering…");
   const contours = $("draw-contours").checked ? loadContours(controller.signal) : null;
   try {
@@ -119,6 +140,8 @@ async function renderFull() {
     if (controller.signal.aborted) return;
     page.renders += 1;
     page.lastAnswer = answer;
+    rememberFrame(answer.camera, sentView);
+    loadTessellation(answer.stats.triangles);
     const now = performance.now();
     if (page.firstPictureMs === null) page.firstPictureMs = now;
     if (state.dragEndedAt !== null) {
@@ -144,6 +167,7 @@ async function renderFull() {
 async function showAnswer(answer, compare) {
   const image = answer.images[mainOutput()] || answer.images.color;
   const shown = [showImage($("picture"), image)];
+  $("gl-canvas").hidden = true;
   $("picture").classList.toggle("hidden-surface", !$("draw-surface").checked);
   drawClientCage(answer.camera);
   const s = answer.stats, t = answer.timings;
@@ -173,7 +197,7 @@ async function renderPreview() {
     const size = Math.max(64, Math.round(fullSize() / PREVIEW_DIVISOR));
     const answer = await state.mesh.withId(
         (mesh) => post("/v1/render", renderBody(mesh, size, false)));
-    if (state.dragging || state.full === null) {
+    if ((state.dragging || state.full === null) && $("gl-canvas").hidden) {
       await showImage($("picture"), answer.images[mainOutput()] || answer.images.color);
       drawClientCage(answer.camera);
       page.previews += 1;
@@ -187,6 +211,86 @@ async function renderPreview() {
       renderPreview();
     }
   }
+}
+
+// ---------------------------------------------------------------- the local view while dragging
+
+const framingRadii = (fovYDeg) => 1.05 / Math.sin((fovYDeg * Math.PI) / 360);
+
+// The mesh's bounding sphere as the server sees it, from an answer's camera and the orbit the
+// page asked for: target = its centre, |eye - target| = distance (in radii) * radius.
+function rememberFrame(camera, sentView) {
+  const d = Math.hypot(...camera.eye.map((e, i) => e - camera.target[i]));
+  const radii = sentView.distance || framingRadii(camera.fovYDeg);
+  state.frame = { target: camera.target, radius: d / radii, fovYDeg: camera.fovYDeg };
+}
+
+// What resolveCamera (render/core/camera.cpp) makes of the page's orbit.
+function orbitCamera() {
+  const { target, radius, fovYDeg } = state.frame;
+  const az = (state.view.azimuthDeg * Math.PI) / 180, el = (state.view.elevationDeg * Math.PI) / 180;
+  const dir = [Math.cos(el) * Math.sin(az), Math.sin(el), Math.cos(el) * Math.cos(az)];
+  const distance = (state.view.distance || framingRadii(fovYDeg)) * radius;
+  return {
+    eye: target.map((t, i) => t + dir[i] * distance),
+    target,
+    up: [-Math.sin(el) * Math.sin(az), Math.cos(el), -Math.sin(el) * Math.cos(az)],
+    fovYDeg,
+    near: Math.max(distance - 1.01 * radius, radius * 1e-3),
+    far: distance + 1.01 * radius,
+  };
+}
+
+// The approximation's triangles for the local view: fetched after a full render whenever the
+// mesh, method or parameters changed, unless they are too many to send quickly.
+// Which approximation the local view would show now.
+const tessellationKey = () =>
+  JSON.stringify([state.mesh?.id, $("method").value, methodParams()]);
+
+async function loadTessellation(triangles) {
+  const view = state.glView;
+  if (!view || !state.mesh) return;
+  const key = tessellationKey();
+  if (view.key === key || $("method").value === "limit" || triangles > LOCAL_MAX_TRIANGLES) return;
+  state.tessellation?.abort();
+  const controller = (state.tessellation = new AbortController());
+  try {
+    const glb = await state.mesh.withId(
+        (mesh) => postBinary("/v1/tessellate",
+                             { mesh, camera: cameraFor(fullSize()), method: $("method").value,
+                               params: methodParams() },
+                             { signal: controller.signal, accept: "model/gltf-binary" }),
+        controller.signal);
+    view.setMesh(parseGlb(glb), key);
+  } catch (problem) {
+    if (problem.name !== "AbortError") console.warn("no local view:", problem.message);
+  }
+}
+
+let frameRequested = false;
+// One frame of the local view at the current orbit (at most one per display frame).
+function drawLocal() {
+  if (frameRequested) return;
+  frameRequested = true;
+  requestAnimationFrame(() => {
+    frameRequested = false;
+    if (!state.glView?.ready || !state.frame) return;
+    state.glView.draw(orbitCamera(), fullSize(), {
+      surface: $("draw-surface").checked, cage: $("draw-cage").checked,
+      flat: $("shading").value === "flat",
+    });
+    $("gl-canvas").hidden = false;
+    $("picture").classList.add("hidden-surface");
+    $("cage-canvas").hidden = true;
+    page.localFrames += 1;
+  });
+}
+
+// While the camera moves: the local view when it can, else a small render.
+function previewMove() {
+  hideContours();
+  const local = state.glView?.ready && state.glView.key === tessellationKey() && state.frame;
+  if (local) drawLocal(); else renderPreview();
 }
 
 // The contour of the limit surface (POST /v1/silhouette, SVG: hidden pieces dashed), laid over
@@ -358,6 +462,11 @@ async function useMesh(source, label) {
   state.full?.abort();
   state.meshText = source;
   state.mesh = new UploadedMesh(wireMesh(source));
+  state.frame = null;  // until the first answer for this mesh
+  if (state.glView) {
+    const { points, faces } = cageOf(source);
+    state.glView.setCage(points, faces);
+  }
   clearErrors();
   setBusy("uploading the mesh…");
   try {
@@ -442,7 +551,7 @@ function bindCamera() {
     v.azimuthDeg = (((v.azimuthDeg - dx * 0.5) % 360) + 540) % 360 - 180;
     v.elevationDeg = Math.max(-89, Math.min(89, v.elevationDeg + dy * 0.5));
     describeView();
-    renderPreview();
+    previewMove();
   });
   const end = () => {
     if (!last) return;
@@ -462,7 +571,7 @@ function bindCamera() {
     const current = v.distance || 3.5;  // about the default framing at 35 degrees
     v.distance = Math.max(1.05, Math.min(40, current * Math.pow(1.0015, event.deltaY)));
     describeView();
-    renderPreview();
+    previewMove();
     clearTimeout(wheelTimer);
     wheelTimer = setTimeout(renderFull, 250);
   }, { passive: false });
@@ -534,6 +643,13 @@ function bindControls() {
 }
 
 async function start() {
+  const options = new URLSearchParams(location.search);
+  try {
+    // ?preview=server: drag previews by small renders even where WebGL 2 works.
+    if (options.get("preview") !== "server") state.glView = new MeshView($("gl-canvas"));
+  } catch (error) {
+    console.warn(`drag previews by small renders: ${error.message}`);
+  }
   showMethodParams();
   describeView();
   bindControls();
@@ -546,7 +662,7 @@ async function start() {
   }
   for (const e of state.examples) $("example").add(new Option(e.title, e.name));
   $("example").add(new Option("(uploaded file)", ""));
-  const first = new URLSearchParams(location.search).get("example") || "torus_creased";
+  const first = options.get("example") || "torus_creased";
   $("example").value = first;
   await loadExample(first);
 }

@@ -170,9 +170,11 @@ describe("limn's page", () => {
     assert.ok(changed > 0.005, `only ${(100 * changed).toFixed(3)}% of the pixels changed`);
   });
 
-  it("orbits on a drag: previews while dragging, a new full-size render after", async () => {
+  it("orbits on a drag: the page draws the view itself, the full picture follows", async () => {
+    // The approximation's triangles arrive after a full render (POST /v1/tessellate).
+    await page.waitForFunction(() => window.limnPage.localReady, null, { timeout: 60_000 });
     const azimuth = await page.$eval("#view", (el) => Number(el.dataset.azimuth));
-    const { renders, previews } = await page.evaluate(() => ({ ...window.limnPage }));
+    const { renders, previews, localFrames } = await page.evaluate(() => ({ ...window.limnPage }));
     await keepPixels("#picture", "beforeDrag");
     const box = await page.locator("#view").boundingBox();
     const x = box.x + box.width / 2, y = box.y + box.height / 2;
@@ -181,19 +183,61 @@ describe("limn's page", () => {
     for (let i = 1; i <= 30; i++) {
       await page.mouse.move(x + 6 * i, y + 2 * i);
       await page.waitForTimeout(30);
+      if (i === 20) await shot("drag-local-view", page.locator("#view"));
     }
     await page.mouse.up();
     await waitForRenders(renders + 1);
     const state = await page.evaluate(() => ({ ...window.limnPage }));
     timings.dragToFullMs = state.dragToFullMs;
+    timings.localFramesDuringDrag = state.localFrames - localFrames;
     console.log(`drag end to full-size picture: ${state.dragToFullMs.toFixed(0)} ms ` +
-                `(${state.previews - previews} previews during the drag)`);
+                `(${state.localFrames - localFrames} local frames, ` +
+                `${state.previews - previews} server previews during the drag)`);
     const after = await page.$eval("#view", (el) => Number(el.dataset.azimuth));
     assert.ok(Math.abs(after - azimuth) > 45, `azimuth ${azimuth} -> ${after}`);
-    assert.ok(state.previews > previews, "no preview arrived during the drag");
+    assert.ok(state.localFrames - localFrames >= 10, "the page drew few frames during the drag");
     await keepPixels("#picture", "afterDrag");
     assert.ok(await differingFraction("beforeDrag", "afterDrag") > 0.01, "the view did not turn");
     assert.equal(await page.$eval("#picture", (img) => img.naturalWidth), 512);
+    assert.ok(await page.locator("#gl-canvas").isHidden(), "the local view stays over the picture");
+    // The local view and the server's picture of the same camera agree: the page's orbit is
+    // the server's.
+    await page.evaluate(async () => {
+      const img = new Image();
+      img.src = window.limnPage.localSnapshot();
+      await img.decode();
+      img.id = "local-snapshot";
+      img.hidden = true;
+      document.body.append(img);
+    });
+    await keepPixels("#local-snapshot", "local");
+    const disagree = await differingFraction("afterDrag", "local");
+    console.log(`local view vs server picture: ${(100 * disagree).toFixed(2)}% of pixels differ`);
+    assert.ok(disagree < 0.03, `${(100 * disagree).toFixed(2)}% of the pixels differ`);
+    await page.$eval("#local-snapshot", (img) => img.remove());
+    await page.$eval("#gl-canvas", (c) => { c.hidden = true; });
+  });
+
+  it("previews a drag with small renders where it does not draw the view itself", async () => {
+    const other = await browser.newPage({ viewport: { width: 1240, height: 800 } });
+    await other.goto(baseUrl + "/?preview=server&example=cube");
+    await other.waitForFunction(() => window.limnPage.renders >= 1 && !window.limnPage.busy);
+    const box = await other.locator("#view").boundingBox();
+    const x = box.x + box.width / 2, y = box.y + box.height / 2;
+    await other.mouse.move(x, y);
+    await other.mouse.down();
+    for (let i = 1; i <= 20; i++) {
+      await other.mouse.move(x - 5 * i, y);
+      await other.waitForTimeout(30);
+    }
+    await other.mouse.up();
+    await other.waitForFunction(() => window.limnPage.renders >= 2 && !window.limnPage.busy);
+    const state = await other.evaluate(() => ({ ...window.limnPage }));
+    console.log(`server previews: ${state.previews} during the drag, then the full picture ` +
+                `${state.dragToFullMs.toFixed(0)} ms after its end`);
+    assert.ok(state.previews >= 3, `${state.previews} previews`);
+    assert.equal(state.localFrames, 0);
+    await other.close();
   });
 
   it("overlays the contour from /v1/silhouette and draws the cage alone without the surface",
