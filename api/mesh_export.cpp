@@ -1,43 +1,18 @@
 #include "api/mesh_export.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <limits>
+
+#include "api/accept.h"
 
 namespace limn::api {
 
 namespace {
 
 using render::tessellate::TriangleMesh;
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
-bool sameIgnoringCase(std::string_view a, std::string_view b) {
-  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
-           return std::tolower(static_cast<unsigned char>(x)) ==
-                  std::tolower(static_cast<unsigned char>(y));
-         });
-}
-
-// The q of "q=0.5;..." parameters (1 when absent or unreadable).
-double quality(std::string_view parameters) {
-  while (!parameters.empty()) {
-    size_t semicolon = parameters.find(';');
-    std::string_view p = trim(parameters.substr(0, semicolon));
-    parameters = semicolon == std::string_view::npos ? "" : parameters.substr(semicolon + 1);
-    if (p.size() > 2 && (p[0] == 'q' || p[0] == 'Q') && p[1] == '=') {
-      return std::strtod(std::string(p.substr(2)).c_str(), nullptr);
-    }
-  }
-  return 1.0;
-}
 
 void append(std::string& out, const void* data, size_t bytes) {
   out.append(static_cast<const char*>(data), bytes);
@@ -65,7 +40,7 @@ std::string number(double v) {
 }  // namespace
 
 std::optional<MeshFormat> chooseMeshFormat(std::string_view accept) {
-  if (trim(accept).empty()) return MeshFormat::Glb;
+  if (parseAccept(accept).empty()) return MeshFormat::Glb;
   struct Candidate {
     const char* type;
     MeshFormat format;
@@ -77,18 +52,12 @@ std::optional<MeshFormat> chooseMeshFormat(std::string_view accept) {
                                          {"model/obj", MeshFormat::Obj}};
   std::optional<MeshFormat> best;
   double bestQ = 0, anyQ = 0;
-  while (!accept.empty()) {
-    size_t comma = accept.find(',');
-    std::string_view range = accept.substr(0, comma);
-    accept = comma == std::string_view::npos ? "" : accept.substr(comma + 1);
-    size_t semicolon = range.find(';');
-    std::string_view type = trim(range.substr(0, semicolon));
-    double q = semicolon == std::string_view::npos ? 1.0 : quality(range.substr(semicolon + 1));
-    if (type == "*/*" || sameIgnoringCase(type, "model/*")) anyQ = std::max(anyQ, q);
+  for (const MediaRange& range : parseAccept(accept)) {
+    if (range.type == "*/*" || sameMediaType(range.type, "model/*")) anyQ = std::max(anyQ, range.q);
     for (const Candidate& c : kTypes) {
-      if (sameIgnoringCase(type, c.type) && q > bestQ) {
+      if (sameMediaType(range.type, c.type) && range.q > bestQ) {
         best = c.format;
-        bestQ = q;
+        bestQ = range.q;
       }
     }
   }

@@ -36,7 +36,7 @@ run_target() {
 summary() {
   local log="build-sanitize/fuzz-logs/$1.log"
   local runs cov units
-  runs=$(awk -F: '/stat::number_of_executed_units/ {gsub(/ /, "", $2); print $2}' "$log")
+  runs=$(awk '/stat::number_of_executed_units/ {print $NF}' "$log")
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | awk '{print $2}')
   units=$(find "build-sanitize/fuzz-corpus/$1" -type f | wc -l)
   printf '%-20s %12s executions  coverage %6s edges  corpus %5s inputs  %s\n' \

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "tests/integration/http_client.h"
+#include "tests/integration/openapi_check.h"
 #include "tests/integration/server_process.h"
 
 namespace limn::testing {
@@ -164,56 +165,38 @@ TEST_F(ServerTest, OpenApiDocumentDescribesRender) {
 // sent is declared for its operation, and every JSON body validates against the declared
 // schema with no undocumented field (tests/integration/check_openapi.py, python3-jsonschema).
 TEST_F(ServerTest, RealAnswersMatchTheOpenApiDocument) {
-  struct Exchange {
-    const char* method;
-    const char* path;
-    std::string body;
-    Headers headers = {};
-  };
   const std::string silhouetteStats =
       renderBody("silhouette", 64, R"(, "outputs": ["color", "contours"], "reference": true)");
-  const std::vector<Exchange> exchanges = {
-      {"POST", "/v1/render",
+  const std::vector<ApiExchange> exchanges = {
+      {"POST", "/v1/render", "",
        renderBody("adaptive", 64,
                   R"(, "outputs": ["color", "mask", "depth", "normal", "wireframe", "cage"],
                      "reference": true, "params": {"referenceCrossCheck": true})")},
-      {"POST", "/v1/render", silhouetteStats},
-      {"POST", "/v1/render",
+      {"POST", "/v1/render", "", silhouetteStats},
+      {"POST", "/v1/render", "",
        renderBody("uniform", 64, R"(, "params": {"level": 2}, "imageFormat": "exr")")},
-      {"POST", "/v1/render", renderBody("limit", 64, R"(, "outputs": ["color"], "extra": 1)")},
-      {"POST", "/v1/render", "{\"mesh\": "},
-      {"POST", "/v1/render", renderBody("uniform", 64, R"(, "params": {"level": 99})")},
-      {"POST", "/v1/render", R"({"mesh": {"format": "obj", "data": "v 0 0 0\nf 1 2 3\n"}})"},
-      {"GET", "/v1/render", ""},
-      {"POST", "/v1/silhouette", renderBody("silhouette", 64, "")},
-      {"POST", "/v1/silhouette", renderBody("silhouette", 64, ""), {{"Accept", "image/svg+xml"}}},
-      {"POST", "/v1/silhouette", R"({"mesh": 5})"},
-      {"GET", "/healthz", ""},
-      {"GET", "/readyz", ""},
-      {"GET", "/metrics", ""},
-      {"GET", "/openapi.json", ""},
-      {"POST", "/healthz", ""},
+      {"POST", "/v1/render", "", renderBody("limit", 64, R"(, "outputs": ["color"], "extra": 1)")},
+      {"POST", "/v1/render", "", "{\"mesh\": "},
+      {"POST", "/v1/render", "", renderBody("uniform", 64, R"(, "params": {"level": 99})")},
+      {"POST", "/v1/render", "", R"({"mesh": {"format": "obj", "data": "v 0 0 0\nf 1 2 3\n"}})"},
+      {"GET", "/v1/render", "", ""},
+      {"POST", "/v1/silhouette", "", renderBody("silhouette", 64, "")},
+      {"POST",
+       "/v1/silhouette",
+       "",
+       renderBody("silhouette", 64, ""),
+       {{"Accept", "image/svg+xml"}}},
+      {"POST", "/v1/silhouette", "", R"({"mesh": 5})"},
+      {"GET", "/healthz", "", ""},
+      {"GET", "/readyz", "", ""},
+      {"GET", "/metrics", "", ""},
+      {"GET", "/openapi.json", "", ""},
+      {"POST", "/healthz", "", ""},
   };
-  const std::string folder = writeTempFile("", "");
-  std::remove(folder.c_str());
-  ASSERT_EQ(::mkdir(folder.c_str(), 0700), 0);
-  std::set<int> statuses;
-  for (size_t i = 0; i < exchanges.size(); ++i) {
-    const Exchange& e = exchanges[i];
-    HttpResponse r = HttpClient(port()).request(e.method, e.path, e.body, e.headers);
-    statuses.insert(r.status);
-    const std::string name = folder + "/" + std::to_string(100 + i);
-    std::ofstream(name + ".meta") << e.method << " " << e.path << " " << r.status << " "
-                                  << r.header("Content-Type");
-    std::ofstream(name + ".body", std::ios::binary) << r.body;
-  }
-  CommandResult check =
-      runCommand("/usr/bin/python3 '" LIMN_SOURCE_DIR
-                 "/tests/integration/check_openapi.py' '" LIMN_SOURCE_DIR "/api/openapi.json' '" +
-                 folder + "'");
-  runCommand("rm -rf '" + folder + "'");
+  OpenApiCheck check = checkAgainstOpenApi(port(), exchanges);
   EXPECT_EQ(check.status, 0) << check.output;
-  EXPECT_EQ(statuses, (std::set<int>{200, 400, 405, 413, 422})) << "the exchanges cover these";
+  EXPECT_EQ(check.statuses, (std::set<int>{200, 400, 405, 413, 422}))
+      << "the exchanges cover these";
 }
 
 TEST_F(ServerTest, RenderOfACubeAnswersAPng) {

@@ -22,6 +22,7 @@
 
 #include "render/image/encode.h"
 #include "tests/integration/http_client.h"
+#include "tests/integration/openapi_check.h"
 #include "tests/integration/server_process.h"
 
 namespace limn::testing {
@@ -111,13 +112,6 @@ TEST_F(WebServer, OpenApiDocumentDescribesWhatThePageUses) {
 // The new routes' real answers against the document, as server_test does for the others
 // (tests/integration/check_openapi.py: declared statuses and media types, strict schemas).
 TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
-  struct Exchange {
-    const char* method;
-    std::string path;        // as requested
-    const char* documented;  // the document's path (template)
-    std::string body;
-    Headers headers = {};
-  };
   const std::string cube = objMesh(example("cube"));
   const std::string id = upload(cube);
   const std::string big =
@@ -126,7 +120,7 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
         for (int i = 0; i < 2000; ++i) v += "v 1 2 3\n";
         return v;
       }());
-  const std::vector<Exchange> exchanges = {
+  const std::vector<ApiExchange> exchanges = {
       {"GET", "/", "/", ""},
       {"GET", "/examples", "/examples", ""},
       {"GET", "/examples/pawn", "/examples/{name}", ""},
@@ -162,26 +156,9 @@ TEST_F(WebServer, RealAnswersMatchTheOpenApiDocument) {
        R"({"mesh":{"id":")" + id + R"("},"method":"limit"})"},
       {"POST", "/v1/silhouette", "/v1/silhouette", R"({"mesh":{"id":"feed"}})"},
   };
-  const std::string folder = writeTempFile("", "");
-  std::remove(folder.c_str());
-  ASSERT_EQ(::mkdir(folder.c_str(), 0700), 0);
-  std::set<int> statuses;
-  for (size_t i = 0; i < exchanges.size(); ++i) {
-    const Exchange& e = exchanges[i];
-    HttpResponse r = HttpClient(port()).request(e.method, e.path, e.body, e.headers);
-    statuses.insert(r.status);
-    const std::string name = folder + "/" + std::to_string(100 + i);
-    std::ofstream(name + ".meta") << e.method << " " << e.documented << " " << r.status << " "
-                                  << r.header("Content-Type");
-    std::ofstream(name + ".body", std::ios::binary) << r.body;
-  }
-  CommandResult check =
-      runCommand("/usr/bin/python3 '" LIMN_SOURCE_DIR
-                 "/tests/integration/check_openapi.py' '" LIMN_SOURCE_DIR "/api/openapi.json' '" +
-                 folder + "'");
-  runCommand("rm -rf '" + folder + "'");
+  OpenApiCheck check = checkAgainstOpenApi(port(), exchanges);
   EXPECT_EQ(check.status, 0) << check.output;
-  EXPECT_EQ(statuses, (std::set<int>{200, 400, 404, 405, 406, 413, 422}))
+  EXPECT_EQ(check.statuses, (std::set<int>{200, 400, 404, 405, 406, 413, 422}))
       << "the exchanges cover these";
 }
 
