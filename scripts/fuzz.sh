@@ -8,6 +8,7 @@
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 60 s, every target)
 #   LIMN_FUZZ_RUNS=10000000 scripts/fuzz.sh 0 obj_reader  (a fixed number of executions)
+#   LIMN_FUZZ_MAX_LEN=4096 ...                              (smaller inputs, more executions)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
@@ -27,7 +28,8 @@ run_target() {
   local limit=(-max_total_time="$seconds")
   [ -n "${LIMN_FUZZ_RUNS:-}" ] && limit=(-runs="$LIMN_FUZZ_RUNS")
   # 64 KiB inputs reach every field; 2 GiB and 10 s per input bound what one input may cost.
-  "build-sanitize/bin/${target}_fuzz" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 \
+  "build-sanitize/bin/${target}_fuzz" "${limit[@]}" -max_len="${LIMN_FUZZ_MAX_LEN:-65536}" \
+    -rss_limit_mb=2048 \
     -timeout=10 -dict="$dict" -print_final_stats=1 \
     -artifact_prefix="build-sanitize/fuzz-findings/${target}-" \
     "$corpus" "fuzz/corpus/$target" >"build-sanitize/fuzz-logs/$target.log" 2>&1
