@@ -375,10 +375,13 @@ namespace request {
 
 void parseJson(std::string_view body, rapidjson::Document& document) {
   // Iterative parsing: a deeply nested body must not exhaust the stack. UTF-8 is validated so
-  // that text echoed back in messages is valid JSON.
-  constexpr unsigned kFlags = rapidjson::kParseIterativeFlag |
-                              rapidjson::kParseValidateEncodingFlag |
-                              rapidjson::kParseFullPrecisionFlag;
+  // that text echoed back in messages is valid JSON. No kParseFullPrecisionFlag: RapidJSON
+  // 1.1.0's full-precision conversion (StrtodDiyFp) reads out of bounds on numbers such as
+  // 0.00000000017994409662966923262e-320 and crashed the server (found by fuzz/json_mesh); the
+  // default conversion is within a few units in the last place, far below what a mesh or a
+  // camera can show.
+  constexpr unsigned kFlags =
+      rapidjson::kParseIterativeFlag | rapidjson::kParseValidateEncodingFlag;
   document.Parse<kFlags>(body.data(), body.size());
   if (document.HasParseError()) {
     size_t offset = document.GetErrorOffset();

@@ -163,6 +163,24 @@ TEST_F(HostileInput, AbsurdButFiniteCoordinatesAndCamerasAreRefusedByName) {
   }
 }
 
+// Numbers that RapidJSON 1.1.0's full-precision conversion read out of bounds on, crashing the
+// whole server with one request (found by fuzz/json_mesh): now read by its default conversion.
+TEST_F(HostileInput, NumbersThatCrashedTheJsonParserAreRead) {
+  for (const char* number :
+       {"0.00000000017994409662966923262e-320",
+        "199999959999999999999000000000002000000002000000000000000000000000000000000001e-320",
+        "1e-99999999999", "-0.000000000000000000000000000000000000000000000000000001e-300"}) {
+    SCOPED_TRACE(number);
+    const std::string points = std::string("[[") + number +
+                               ",-1,1],[1,-1,1],[-1,1,1],[1,1,1],[-1,1,-1],[1,1,-1],[-1,-1,-1],"
+                               "[1,-1,-1]]";
+    for (const char* path : {"/v1/render", "/v1/silhouette"}) {
+      HttpResponse r = post(port(), path, cubeRequest("", "", points));
+      EXPECT_EQ(r.status, 200) << path << ": " << r.body.substr(0, 300);
+    }
+  }
+}
+
 // The same values in the OBJ form: the line is named.
 TEST_F(HostileInput, ObjCoordinatesAndSharpnessesThatAreNotFiniteNameTheLine) {
   for (const char* value :

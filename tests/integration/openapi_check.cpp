@@ -20,8 +20,9 @@ OpenApiCheck checkAgainstOpenApi(int port, const std::vector<ApiExchange>& excha
     HttpResponse r = HttpClient(port).request(e.method, e.path, e.body, e.headers);
     check.statuses.insert(r.status);
     const std::string name = folder + "/" + std::to_string(100 + i);
-    std::ofstream(name + ".meta") << e.method << " " << (e.documented.empty() ? e.path : e.documented)
-                                  << " " << r.status << " " << r.header("Content-Type");
+    std::ofstream(name + ".meta") << e.method << " "
+                                  << (e.documented.empty() ? e.path : e.documented) << " "
+                                  << r.status << " " << r.header("Content-Type");
     std::ofstream(name + ".body", std::ios::binary) << r.body;
   }
   CommandResult result =

@@ -14,8 +14,9 @@ namespace limn::testing {
 
 struct ApiExchange {
   std::string method;
-  std::string path;        // as requested
-  std::string documented;  // the document's path for it ("" = path; templates like /examples/{name})
+  std::string path;  // as requested
+  std::string
+      documented;  // the document's path for it ("" = path; templates like /examples/{name})
   std::string body;
   Headers headers = {};
 };
