@@ -74,14 +74,26 @@ std::vector<uint8_t> coveredPixels(const ImageSet& set, int width, int height, c
   return covered;
 }
 
+// One pass of both image sets, checked to be the same size, with each side's coverage.
+struct ComparedPass {
+  const Image& a;  // the approximation's
+  const Image& b;  // the reference's
+  std::vector<uint8_t> coveredA, coveredB;
+};
+
+ComparedPass comparePass(const ImageSet& approx, const ImageSet& reference, const char* name,
+                         int minChannels) {
+  const Image& a = requirePass(approx, name, minChannels, "approximation");
+  const Image& b = requirePass(reference, name, minChannels, "reference");
+  requireSameSize(a, b, name);
+  return {a, b, coveredPixels(approx, a.width, a.height, "approximation"),
+          coveredPixels(reference, b.width, b.height, "reference")};
+}
+
 }  // namespace
 
 ColorMetrics compareColor(const ImageSet& approx, const ImageSet& reference) {
-  const Image& a = requirePass(approx, pass::kColor, 3, "approximation");
-  const Image& b = requirePass(reference, pass::kColor, 3, "reference");
-  requireSameSize(a, b, pass::kColor);
-  const std::vector<uint8_t> coveredA = coveredPixels(approx, a.width, a.height, "approximation");
-  const std::vector<uint8_t> coveredB = coveredPixels(reference, b.width, b.height, "reference");
+  const auto [a, b, coveredA, coveredB] = comparePass(approx, reference, pass::kColor, 3);
 
   double sumSquared = 0;
   size_t pixels = 0;
@@ -124,11 +136,7 @@ std::array<float, 3> heatRamp(double t) {
 }  // namespace
 
 DiffImage colorDifference(const ImageSet& approx, const ImageSet& reference) {
-  const Image& a = requirePass(approx, pass::kColor, 3, "approximation");
-  const Image& b = requirePass(reference, pass::kColor, 3, "reference");
-  requireSameSize(a, b, pass::kColor);
-  const std::vector<uint8_t> coveredA = coveredPixels(approx, a.width, a.height, "approximation");
-  const std::vector<uint8_t> coveredB = coveredPixels(reference, b.width, b.height, "reference");
+  const auto [a, b, coveredA, coveredB] = comparePass(approx, reference, pass::kColor, 3);
 
   constexpr double kSmallestScale = 1.0 / 255.0;          // one step of an 8-bit colour
   std::vector<double> difference(coveredA.size(), -1.0);  // -1: covered in neither
@@ -158,11 +166,7 @@ DepthMetrics compareDepth(const ImageSet& approx, const ImageSet& reference, dou
     throw std::invalid_argument("compareDepth: the bounding-box diagonal must be positive, got " +
                                 std::to_string(diagonal));
   }
-  const Image& a = requirePass(approx, pass::kDepth, 1, "approximation");
-  const Image& b = requirePass(reference, pass::kDepth, 1, "reference");
-  requireSameSize(a, b, pass::kDepth);
-  const std::vector<uint8_t> coveredA = coveredPixels(approx, a.width, a.height, "approximation");
-  const std::vector<uint8_t> coveredB = coveredPixels(reference, b.width, b.height, "reference");
+  const auto [a, b, coveredA, coveredB] = comparePass(approx, reference, pass::kDepth, 1);
 
   double maxDiff = 0, sumDiff = 0;
   size_t pixels = 0;
@@ -181,11 +185,7 @@ DepthMetrics compareDepth(const ImageSet& approx, const ImageSet& reference, dou
 }
 
 NormalMetrics compareNormals(const ImageSet& approx, const ImageSet& reference) {
-  const Image& a = requirePass(approx, pass::kNormal, 3, "approximation");
-  const Image& b = requirePass(reference, pass::kNormal, 3, "reference");
-  requireSameSize(a, b, pass::kNormal);
-  const std::vector<uint8_t> coveredA = coveredPixels(approx, a.width, a.height, "approximation");
-  const std::vector<uint8_t> coveredB = coveredPixels(reference, b.width, b.height, "reference");
+  const auto [a, b, coveredA, coveredB] = comparePass(approx, reference, pass::kNormal, 3);
 
   double maxDeg = 0, sumDeg = 0;
   size_t pixels = 0;
