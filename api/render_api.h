@@ -30,6 +30,17 @@ struct RenderRequest {
 RenderRequest parseRenderRequest(std::string_view json, const render::pipeline::JobLimits& limits,
                                  render::mesh::MeshCache* meshes = nullptr);
 
+// What of a RenderResult the answer shows, and how: the outputs asked for, whether a reference
+// was, the image encoding, and the parser's warnings (written before the engine's).
+struct AnswerShape {
+  const render::pipeline::Outputs& outputs;
+  bool reference;
+  render::image::Format imageFormat;
+  const std::vector<std::string>& warnings;
+};
+std::string writeRenderResponse(const render::pipeline::RenderResult& result,
+                                const AnswerShape& shape);
+
 // The 200 answer's JSON: images (base64), reference.images, metrics, stats, timings, warnings,
 // camera. timings.totalMs = result.timings.parseMs + result.timings.totalMs (the engine's run)
 // + the time spent here encoding, which is also written as timings.encodeMs.

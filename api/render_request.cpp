@@ -231,7 +231,7 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
   return out;
 }
 
-render::pipeline::Outputs parseOutputs(const Value& value) {
+render::pipeline::Outputs readOutputs(const Value& value) {
   json::requireArray(value, "outputs");
   render::pipeline::Outputs out;
   out.color = false;
@@ -327,13 +327,8 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   if (const Value* v = json::find(root, "camera")) job.camera = parseCamera(*v, limits, warnings);
   if (const Value* v = json::find(root, "method")) job.method = parseMethod(*v);
   if (const Value* v = json::find(root, "params")) job.params = parseParams(*v, limits, warnings);
-  if (const Value* v = json::find(root, "shading")) {
-    job.shading = json::choice<render::Shading>(*v, "shading",
-                                                {{"flat", render::Shading::Flat},
-                                                 {"smooth", render::Shading::Smooth},
-                                                 {"normal-map", render::Shading::NormalMap}});
-  }
-  if (const Value* v = json::find(root, "outputs")) job.outputs = parseOutputs(*v);
+  if (const Value* v = json::find(root, "shading")) job.shading = request::parseShading(*v);
+  if (const Value* v = json::find(root, "outputs")) job.outputs = readOutputs(*v);
   if (job.outputs.contours && job.method != Method::Silhouette) {
     json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
   }
@@ -356,9 +351,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
                "\"reference\": true and a method other than \"limit\"");
   }
   if (const Value* v = json::find(root, "imageFormat")) {
-    request.imageFormat = json::choice<render::image::Format>(
-        *v, "imageFormat",
-        {{"png", render::image::Format::Png}, {"exr", render::image::Format::Exr}});
+    request.imageFormat = request::parseImageFormat(*v);
   }
 
   const Value* mesh = json::find(root, "mesh");
@@ -415,9 +408,27 @@ void parseSilhouetteParams(const Value& params, const JobLimits& limits,
   api::parseSilhouetteParams(params, limits, out);
 }
 
+render::pipeline::Outputs parseOutputs(const Value& outputs) { return readOutputs(outputs); }
+
+render::Shading parseShading(const Value& shading) {
+  return json::choice<render::Shading>(shading, "shading",
+                                       {{"flat", render::Shading::Flat},
+                                        {"smooth", render::Shading::Smooth},
+                                        {"normal-map", render::Shading::NormalMap}});
+}
+
+render::image::Format parseImageFormat(const Value& format) {
+  return json::choice<render::image::Format>(
+      format, "imageFormat",
+      {{"png", render::image::Format::Png}, {"exr", render::image::Format::Exr}});
+}
+
 void checkCameraAgainstMesh(const render::CameraSpec& camera,
                             const render::mesh::ControlMesh& mesh) {
-  const render::Bounds bounds = mesh.bounds();
+  checkCameraAgainstBounds(camera, mesh.bounds());
+}
+
+void checkCameraAgainstBounds(const render::CameraSpec& camera, const render::Bounds& bounds) {
   const render::Vec3 centre = bounds.center();
   // The rasteriser's float precision is relative to the mesh's size: a camera a million radii
   // away (or an orthographic view a million times larger or smaller than the mesh) cannot be
@@ -427,7 +438,7 @@ void checkCameraAgainstMesh(const render::CameraSpec& camera,
   auto checkDistance = [&](const std::optional<render::Vec3>& point, const char* field) {
     if (point && render::length(*point - centre) > kMaxScale * radius) {
       json::fail(field, std::string(field) + " is more than 1e6 bounding radii (" +
-                            json::formatNumber(radius) + ") from the mesh's centre");
+                            json::formatNumber(radius) + ") from the surface's centre");
     }
   };
   checkDistance(camera.eye, "camera.eye");
@@ -439,7 +450,7 @@ void checkCameraAgainstMesh(const render::CameraSpec& camera,
   if (camera.orthoHeight &&
       !(*camera.orthoHeight <= kMaxScale * radius && *camera.orthoHeight >= radius / kMaxScale)) {
     json::fail("camera.orthoHeight",
-               "camera.orthoHeight must be within 1e6 times the mesh's "
+               "camera.orthoHeight must be within 1e6 times the surface's "
                "bounding radius (" +
                    json::formatNumber(radius) + ")");
   }

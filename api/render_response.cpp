@@ -34,10 +34,10 @@ std::vector<const char*> requestedPasses(const Outputs& outputs) {
   return names;
 }
 
-void writeImages(Writer& w, const render::ImageSet& images, const RenderRequest& request,
+void writeImages(Writer& w, const render::ImageSet& images, const AnswerShape& shape,
                  const char* owner, std::vector<std::string>& warnings) {
   w.StartObject();
-  for (const char* name : requestedPasses(request.job.outputs)) {
+  for (const char* name : requestedPasses(shape.outputs)) {
     // The contour and cage overlays are drawn over the method's image, and the diff compares
     // it with the reference; the reference has none of them.
     if (std::string_view(owner) == "reference" &&
@@ -52,7 +52,7 @@ void writeImages(Writer& w, const render::ImageSet& images, const RenderRequest&
                          " did not produce it");
       continue;
     }
-    render::image::EncodedImage encoded = render::image::encode(*image, name, request.imageFormat);
+    render::image::EncodedImage encoded = render::image::encode(*image, name, shape.imageFormat);
     w.Key(name);
     w.StartObject();
     w.Key("mime");
@@ -114,6 +114,7 @@ void writeMetrics(Writer& w, const render::metrics::Metrics& m) {
     numberField(w, "maxDist", m.geometry->maxDist);
     numberField(w, "meanDist", m.geometry->meanDist);
     numberField(w, "relMaxDist", m.geometry->relMaxDist);
+    numberField(w, "relMeanDist", m.geometry->relMeanDist);
     w.EndObject();
   }
   w.EndObject();
@@ -147,6 +148,36 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
   w.EndObject();
 }
 
+void writeImplicitStats(Writer& w, const render::pipeline::Stats::Implicit& s) {
+  const render::implicit::PolygonizerStats& p = s.polygonizer;
+  w.Key("implicit");
+  w.StartObject();
+  auto count = [&](const char* key, size_t value) {
+    w.Key(key);
+    w.Uint64(value);
+  };
+  count("primitives", s.primitives);
+  w.Key("polygonizer");
+  w.String(render::implicit::polygonizerName(s.method));
+  count("boundaryEdges", s.closure.boundaryEdges);
+  count("nonManifoldEdges", s.closure.nonManifoldEdges);
+  count("misorientedEdges", s.closure.misorientedEdges);
+  count("cellsVisited", p.cellsVisited);
+  count("fieldSamples", p.fieldSamples);
+  count("octreeLeaves", p.octreeLeaves);
+  count("edgesSplit", p.edgesSplit);
+  w.Key("gridCells");
+  w.StartArray();
+  for (int n : p.gridCells) w.Int(n);
+  w.EndArray();
+  numberField(w, "cellSize", p.cellSize);
+  numberField(w, "sampleMs", p.sampleMs);
+  numberField(w, "polygonizeMs", p.polygonizeMs);
+  numberField(w, "vertexMs", p.vertexMs);
+  numberField(w, "sampleMvoxelsPerS", p.sampleMvoxelsPerS);
+  w.EndObject();
+}
+
 void writeStats(Writer& w, const render::pipeline::Stats& s) {
   w.StartObject();
   w.Key("controlVertices");
@@ -171,6 +202,11 @@ void writeStats(Writer& w, const render::pipeline::Stats& s) {
     }
   }
   if (s.silhouette) writeSilhouetteStats(w, *s.silhouette, s.presubdivided);
+  if (s.implicit) {
+    w.Key("closed");
+    w.Bool(s.implicit->closure.closed());
+    writeImplicitStats(w, *s.implicit);
+  }
   w.EndObject();
 }
 
@@ -236,22 +272,30 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
 
 std::string writeRenderResponse(const render::pipeline::RenderResult& result,
                                 const RenderRequest& request) {
+  return writeRenderResponse(result, AnswerShape{.outputs = request.job.outputs,
+                                                 .reference = request.job.reference,
+                                                 .imageFormat = request.imageFormat,
+                                                 .warnings = request.warnings});
+}
+
+std::string writeRenderResponse(const render::pipeline::RenderResult& result,
+                                const AnswerShape& shape) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
-  std::vector<std::string> warnings = request.warnings;
+  std::vector<std::string> warnings = shape.warnings;
   warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
 
   rapidjson::StringBuffer buffer;
   Writer w(buffer);
   w.StartObject();
   w.Key("images");
-  writeImages(w, result.images, request, "method", warnings);
-  if (request.job.reference) {
+  writeImages(w, result.images, shape, "method", warnings);
+  if (shape.reference) {
     w.Key("reference");
     w.StartObject();
     w.Key("images");
     if (result.referenceImages) {
-      writeImages(w, *result.referenceImages, request, "reference", warnings);
+      writeImages(w, *result.referenceImages, shape, "reference", warnings);
     } else {
       w.StartObject();
       w.EndObject();

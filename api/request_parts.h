@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "render/core/camera.h"
+#include "render/image/encode.h"
 #include "render/mesh/control_mesh.h"
 #include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
@@ -50,5 +51,16 @@ void parseSilhouetteParams(const rapidjson::Value& params,
 // mesh, an orthoHeight beyond 1e6 times the radius either way.
 void checkCameraAgainstMesh(const render::CameraSpec& camera,
                             const render::mesh::ControlMesh& mesh);
+// The same against any surface's bounding box (an implicit field's domain).
+void checkCameraAgainstBounds(const render::CameraSpec& camera, const render::Bounds& bounds);
+
+// "outputs": ["color", "mask", ...] (400 naming the element that is not an output's name).
+render::pipeline::Outputs parseOutputs(const rapidjson::Value& outputs);
+
+// "shading": "flat" | "smooth" | "normal-map".
+render::Shading parseShading(const rapidjson::Value& shading);
+
+// "imageFormat": "png" | "exr".
+render::image::Format parseImageFormat(const rapidjson::Value& format);
 
 }  // namespace limn::api::request

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "api/config.h"
+#include "api/implicit_api.h"
 #include "api/render_api.h"
 #include "render/core/error.h"
 #include "render/image/encode.h"
@@ -232,9 +233,17 @@ int renderCommand(const CommandLine& cl) {
   auto text = readFile(cl.positional[0]);
   if (!text) return usageError("cannot read " + cl.positional[0]);
 
+  // The same command takes /v1/render's body and /v1/implicit's (which has a "field").
+  const bool implicit = api::isImplicitRequest(*text);
   api::RenderRequest request;
+  api::ImplicitRequest implicitRequest;
   try {
-    request = api::parseRenderRequest(*text, config->limits);
+    if (implicit) {
+      implicitRequest = api::parseImplicitRequest(*text, config->limits);
+      request.imageFormat = implicitRequest.imageFormat;
+    } else {
+      request = api::parseRenderRequest(*text, config->limits);
+    }
   } catch (const api::ApiError& e) {
     return fail(e, 2);
   }
@@ -244,7 +253,10 @@ int renderCommand(const CommandLine& cl) {
     render::raster::Rasterizer rasterizer;
     render::pipeline::RenderContext context;
     context.rasterizer = &rasterizer;
-    result = render::pipeline::run(request.job, config->limits, context, render::CancelToken{});
+    result = implicit ? render::pipeline::runImplicit(implicitRequest.job, config->limits, context,
+                                                      render::CancelToken{})
+                      : render::pipeline::run(request.job, config->limits, context,
+                                              render::CancelToken{});
   } catch (const render::InputError& e) {
     return fail(api::fromInputError(e), 2);
   } catch (const std::exception& e) {
@@ -254,7 +266,13 @@ int renderCommand(const CommandLine& cl) {
   try {
     std::filesystem::path dir(*cl.out);
     std::filesystem::create_directories(dir);
-    std::string json = api::writeRenderResponse(*result, request);
+    std::string json =
+        implicit ? api::writeRenderResponse(
+                       *result, api::AnswerShape{.outputs = implicitRequest.job.outputs,
+                                                 .reference = implicitRequest.job.reference,
+                                                 .imageFormat = implicitRequest.imageFormat,
+                                                 .warnings = implicitRequest.warnings})
+                 : api::writeRenderResponse(*result, request);
     writeFile(dir / "response.json", json.data(), json.size());
     std::vector<std::string> written{(dir / "response.json").string()};
     auto writeSet = [&](const render::ImageSet& set, const std::string& prefix) {

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "api/implicit_api.h"
 #include "api/openapi.h"
 #include "api/silhouette_api.h"
 #include "server/web_assets.h"
@@ -27,7 +28,7 @@ struct Route {
 constexpr Route kRoutes[] = {
     {"/healthz", "GET"},      {"/readyz", "GET"},         {"/metrics", "GET"},
     {"/openapi.json", "GET"}, {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
-    {"/v1/meshes", "POST"},   {"/v1/tessellate", "POST"},
+    {"/v1/meshes", "POST"},   {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
 };
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
@@ -163,6 +164,9 @@ WorkerPool::Abandon Router::route(Request request, Reply reply) {
   if (path == "/v1/tessellate") {
     return tessellate(std::move(request.body), std::move(request.accept), std::move(reply));
   }
+  if (path == "/v1/implicit") {
+    return implicit(std::move(request.body), std::move(request.accept), std::move(reply));
+  }
   return render(std::move(request.body), std::move(reply));
 }
 
@@ -208,6 +212,16 @@ WorkerPool::Abandon Router::render(std::string body, Reply reply) {
       [body = std::move(body), limits = limits_, meshes = meshes_](
           render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
         return api::handleRender(body, limits, context, cancel, meshes);
+      },
+      std::move(reply));
+}
+
+// Implicit scenes: polygonised, drawn and measured on the same workers as meshes.
+WorkerPool::Abandon Router::implicit(std::string body, std::string accept, Reply reply) {
+  return pool_.submit(
+      [body = std::move(body), accept = std::move(accept), limits = limits_](
+          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
+        return api::handleImplicit(body, accept, limits, context, cancel);
       },
       std::move(reply));
 }

@@ -287,33 +287,82 @@ Field::Field(FieldSpec spec) : iso_(spec.iso) {
   if (!sources.empty()) {
     expressions_ = std::make_unique<ExpressionSet>(std::move(sources), std::move(subjects));
   }
-  // Expressions have no analytic bound: estimate the slope of each from central differences
-  // on a 16^3 lattice over the domain, with a safety factor of 2 (docs/implicit.md).
-  const Vec3 size = bounds_.hi - bounds_.lo;
-  const double h = 1e-4 * std::max(length(size), 1e-300);
   for (PreparedPrimitive& prim : primitives_) {
-    if (prim.spec.type != PrimitiveType::Expression) continue;
-    double slope = 0;
-    constexpr int kSamples = 16;
-    for (int k = 0; k <= kSamples; ++k) {
-      for (int j = 0; j <= kSamples; ++j) {
-        for (int i = 0; i <= kSamples; ++i) {
-          Vec3 p = bounds_.lo +
-                   Vec3{size.x * i / kSamples, size.y * j / kSamples, size.z * k / kSamples};
-          Vec3 q = multiply(prim.toLocal, p - prim.origin);
-          auto e = [&](const Vec3& d) {
-            Vec3 x = q + d;
-            return expressions_->evaluate(prim.expressionIndex, x.x, x.y, x.z);
-          };
-          Vec3 g{(e({h, 0, 0}) - e({-h, 0, 0})) / (2 * h), (e({0, h, 0}) - e({0, -h, 0})) / (2 * h),
-                 (e({0, 0, h}) - e({0, 0, -h})) / (2 * h)};
-          slope = std::max(slope, length(g));
+    if (prim.spec.type == PrimitiveType::Expression) estimateSlopes(prim);
+  }
+  for (const PreparedPrimitive& prim : primitives_) lipschitz_ += prim.lipschitz;
+}
+
+// Expressions have no analytic bound: the slope of weight * e^2 is estimated on a lattice of
+// kSlopeCells^3 cells over the domain, from central differences of e at the lattice points,
+// spread to each cell's neighbours and doubled for safety (docs/implicit.md). Rays far from the
+// expression's shape then step at the pace of the other primitives.
+void Field::estimateSlopes(PreparedPrimitive& prim) const {
+  constexpr int n = PreparedPrimitive::kSlopeCells;
+  const Vec3 size = bounds_.hi - bounds_.lo;
+  const Vec3 cell = size / n;
+  const double h = 1e-4 * std::max(length(size), 1e-300);
+  auto e = [&](const Vec3& p) {
+    const Vec3 q = multiply(prim.toLocal, p - prim.origin);
+    return expressions_->evaluate(prim.expressionIndex, q.x, q.y, q.z);
+  };
+  std::vector<double> atPoint((n + 1) * (n + 1) * (n + 1), 0.0);
+  for (int k = 0; k <= n; ++k) {
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        const Vec3 p = bounds_.lo + Vec3{cell.x * i, cell.y * j, cell.z * k};
+        const Vec3 g{(e(p + Vec3{h, 0, 0}) - e(p - Vec3{h, 0, 0})) / (2 * h),
+                     (e(p + Vec3{0, h, 0}) - e(p - Vec3{0, h, 0})) / (2 * h),
+                     (e(p + Vec3{0, 0, h}) - e(p - Vec3{0, 0, h})) / (2 * h)};
+        // d(w e^2)/dp = 2 w e grad e where e < 0; between the lattice points the spreading to
+        // neighbouring cells and the factor of 2 stand in for a bound.
+        const double value = e(p);
+        if (value < 0) {
+          atPoint[(k * (n + 1) + j) * (n + 1) + i] =
+              2.0 * prim.spec.weight * std::fabs(value) * length(g);
         }
       }
     }
-    prim.lipschitz = 2.0 * prim.spec.weight * slope / minScale(prim.spec.transform);
   }
-  for (const PreparedPrimitive& prim : primitives_) lipschitz_ += prim.lipschitz;
+  auto point = [&](int i, int j, int k) { return atPoint[(k * (n + 1) + j) * (n + 1) + i]; };
+  std::vector<float> cells(n * n * n, 0.0f);
+  for (int k = 0; k < n; ++k) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        double largest = 0;
+        for (int c = 0; c < 8; ++c) {
+          largest = std::max(largest, point(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
+        }
+        cells[(k * n + j) * n + i] = static_cast<float>(largest);
+      }
+    }
+  }
+  // Spread each cell's slope to the cells within kSlopeReach + 1 (one for what lies between
+  // lattice points, kSlopeReach so that one lookup bounds a ball of that many cells' radius),
+  // axis by axis.
+  constexpr int spread = PreparedPrimitive::kSlopeReach + 1;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<float> out(cells.size(), 0.0f);
+    const int stride = axis == 0 ? 1 : axis == 1 ? n : n * n;
+    for (int c = 0; c < n * n * n; ++c) {
+      const int at = (c / stride) % n;
+      float largest = 0;
+      for (int d = -spread; d <= spread; ++d) {
+        if (at + d >= 0 && at + d < n) largest = std::max(largest, cells[c + d * stride]);
+      }
+      out[c] = largest;
+    }
+    cells = std::move(out);
+  }
+  prim.slopes.resize(cells.size());
+  prim.lipschitz = 0;
+  for (size_t c = 0; c < cells.size(); ++c) {
+    prim.slopes[c] = 2.0f * cells[c];  // the safety factor
+    prim.lipschitz = std::max(prim.lipschitz, static_cast<double>(prim.slopes[c]));
+  }
+  const Vec3 cellSize = size / n;
+  prim.slopeReach = PreparedPrimitive::kSlopeReach * std::min({cellSize.x, cellSize.y, cellSize.z});
+  prim.slopeBox = bounds_;
 }
 
 Field::~Field() = default;
@@ -385,9 +434,11 @@ double FieldEvaluator::contribution(const PreparedPrimitive& prim, const Vec3& p
       break;
     }
     case PrimitiveType::Expression: {
+      // weight * e^2 inside (e < 0): zero with zero slope on the expression's own surface, as
+      // every falloff here ends, so cuts and blends have no crease for the polygonisers to miss.
       const double e = expressions_->evaluate(prim.expressionIndex, q.x, q.y, q.z);
       if (e >= 0) break;
-      f = -w * e;
+      f = w * e * e;
       if (gradient) {
         const double h = 1e-6 * std::max(1.0, length(q));
         auto at = [&](double x, double y, double z) {
@@ -396,7 +447,7 @@ double FieldEvaluator::contribution(const PreparedPrimitive& prim, const Vec3& p
         gq = Vec3{at(q.x + h, q.y, q.z) - at(q.x - h, q.y, q.z),
                   at(q.x, q.y + h, q.z) - at(q.x, q.y - h, q.z),
                   at(q.x, q.y, q.z + h) - at(q.x, q.y, q.z - h)} *
-             (-w / (2 * h));
+             (2.0 * w * e / (2 * h));
       }
       break;
     }
@@ -428,9 +479,33 @@ double FieldEvaluator::valueAndGradient(const Vec3& p, Vec3& gradient) {
 double FieldEvaluator::lipschitzNear(const Vec3& p, double reach) const {
   double bound = 0;
   for (const PreparedPrimitive& prim : field_.primitives()) {
-    if (boxDistance(prim.support, p) <= reach) bound += prim.lipschitz;
+    if (boxDistance(prim.support, p) > reach) continue;
+    bound += prim.slopes.empty() ? prim.lipschitz : slopeNear(prim, p, reach);
   }
   return bound;
+}
+
+// The slope bound of an expression's lattice cell holding p, which covers the ball (p, reach)
+// when reach is within slopeReach; the global bound otherwise, and outside the lattice.
+double FieldEvaluator::slopeNear(const PreparedPrimitive& prim, const Vec3& p, double reach) {
+  constexpr int n = PreparedPrimitive::kSlopeCells;
+  if (reach > prim.slopeReach) return prim.lipschitz;
+  const Bounds& box = prim.slopeBox;
+  int index[3];
+  for (int a = 0; a < 3; ++a) {
+    const double at = (p[a] - box.lo[a]) / (box.hi[a] - box.lo[a]) * n;
+    if (!(at >= 0 && at < n)) return prim.lipschitz;
+    index[a] = static_cast<int>(at);
+  }
+  return prim.slopes[(index[2] * n + index[1]) * n + index[0]];
+}
+
+double Field::localReach() const {
+  double reach = 1e300;
+  for (const PreparedPrimitive& prim : primitives_) {
+    if (!prim.slopes.empty()) reach = std::min(reach, prim.slopeReach);
+  }
+  return reach;
 }
 
 Vec3 FieldEvaluator::normal(const Vec3& p) {

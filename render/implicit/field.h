@@ -43,8 +43,9 @@ struct Primitive {
   double blobbiness = 2;   // blobby: a = blobbiness / radius^2
   double majorRadius = 1;  // torus: radius of the core circle (about the local z axis)
   double exponent = 8;     // cube: n of |x|^n + |y|^n + |z|^n
-  // expression: e(x, y, z) in local coordinates, negative inside; contributes weight * max(0,
-  // -e). A positive expression needs `bounds` (world box) since {e < 0} may be unbounded.
+  // expression: e(x, y, z) in local coordinates, negative inside; contributes weight * e^2
+  // where e < 0 (0 elsewhere). A positive expression needs `bounds` (world box) when no other
+  // primitive bounds the surface, since {e < 0} may be unbounded.
   std::string expression;
   Bounds bounds;
 };
@@ -65,6 +66,12 @@ struct PreparedPrimitive {
   Bounds support;                 // world box outside which the contribution is below threshold
   double lipschitz = 0;           // of the signed contribution, world units
   int expressionIndex = -1;
+  // Expressions: estimated slopes on a lattice of kSlopeCells^3 cells over slopeBox (field.cpp).
+  // Each cell's value bounds the slope over every ball of radius slopeReach around its points.
+  static constexpr int kSlopeCells = 32, kSlopeReach = 3;
+  std::vector<float> slopes;
+  Bounds slopeBox;
+  double slopeReach = 0;
 };
 
 // The field, checked and prepared. Evaluation needs a FieldEvaluator (one per thread): custom
@@ -84,9 +91,14 @@ class Field {
   const Bounds& bounds() const { return bounds_; }
   double lipschitz() const { return lipschitz_; }
   const ExpressionSet* expressions() const { return expressions_.get(); }
+  // The largest reach for which FieldEvaluator::lipschitzNear stays local (expressions' slope
+  // lattices); unbounded without expressions.
+  double localReach() const;
   bool hasExpressions() const;
 
  private:
+  void estimateSlopes(PreparedPrimitive& prim) const;
+
   std::vector<PreparedPrimitive> primitives_;
   double iso_;
   Bounds bounds_;
@@ -114,6 +126,7 @@ class FieldEvaluator {
 
  private:
   double contribution(const PreparedPrimitive& prim, const Vec3& p, Vec3* gradient);
+  static double slopeNear(const PreparedPrimitive& prim, const Vec3& p, double reach);
   const Field& field_;
   std::unique_ptr<ExpressionSet> expressions_;  // this thread's copy
 };

@@ -173,6 +173,7 @@ GeometryMetrics measureGeometry(const tessellate::TriangleMesh& mesh,
   result.meanDist = total.count == 0 ? 0.0 : total.sum / static_cast<double>(total.count);
   const double diagonal = surface.bounds().diagonal();
   result.relMaxDist = diagonal > 0 ? result.maxDist / diagonal : 0.0;
+  result.relMeanDist = diagonal > 0 ? result.meanDist / diagonal : 0.0;
   return result;
 }
 

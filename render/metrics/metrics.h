@@ -31,7 +31,7 @@ struct NormalMetrics {
   double meanDeg = 0, maxDeg = 0;
 };
 struct GeometryMetrics {
-  double maxDist = 0, meanDist = 0, relMaxDist = 0;
+  double maxDist = 0, meanDist = 0, relMaxDist = 0, relMeanDist = 0;
 };
 
 struct Metrics {

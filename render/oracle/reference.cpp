@@ -13,6 +13,7 @@
 
 #include "render/core/shading.h"
 #include "render/oracle/ray_caster.h"
+#include "render/oracle/reference_passes.h"
 #include "render/oracle/reference_scene.h"
 #include "render/oracle/reference_tessellation.h"
 #include "render/oracle/surface_hit.h"
@@ -30,93 +31,6 @@ double msSince(Clock::time_point start) {
 
 // Newton stops when the point is this close to the ray, relative to the model's size.
 constexpr double kRelativeTolerance = 1e-9;
-
-// The output images of the selected passes, filled pixel by pixel.
-struct PassImages {
-  Image* color = nullptr;
-  Image* mask = nullptr;
-  Image* depth = nullptr;
-  Image* normal = nullptr;
-
-  PassImages(ImageSet& set, const PassSelection& passes, int width, int height) {
-    if (passes.color || passes.wireframe) {
-      color = &set.passes[pass::kColor];
-      *color = Image(width, height, 4);
-      for (size_t i = 0; i < color->pixels.size(); i += 4) {
-        for (int c = 0; c < 3; ++c) color->pixels[i + c] = shading::kBackground[c];
-        color->pixels[i + 3] = 0.0f;
-      }
-    }
-    if (passes.mask) mask = &(set.passes[pass::kMask] = Image(width, height, 1));
-    if (passes.depth) depth = &(set.passes[pass::kDepth] = Image(width, height, 1));
-    if (passes.normal) normal = &(set.passes[pass::kNormal] = Image(width, height, 3));
-  }
-
-  void write(int x, int y, const SurfaceHit& hit, const Camera& camera) {
-    if (mask) mask->at(x, y) = 1.0f;
-    if (depth) depth->at(x, y) = static_cast<float>(camera.depthOf(hit.position));
-    if (normal) {
-      normal->at(x, y, 0) = static_cast<float>(hit.normal.x);
-      normal->at(x, y, 1) = static_cast<float>(hit.normal.y);
-      normal->at(x, y, 2) = static_cast<float>(hit.normal.z);
-    }
-    if (color) {
-      Vec3 toEye = camera.projection() == Projection::Perspective
-                       ? normalize(camera.eye() - hit.position)
-                       : -camera.forward();
-      float rgb[3];
-      shading::shade(hit.normal, toEye, rgb);
-      for (int c = 0; c < 3; ++c) color->at(x, y, c) = rgb[c];
-      color->at(x, y, 3) = 1.0f;
-    }
-  }
-};
-
-// Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
-// outline candidates, those with an 8-neighbour of other coverage, and those where the hint's
-// block is mixed or disagrees with the pixel.
-std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
-                                 int width, int height, const Image* hint, int s) {
-  constexpr uint8_t kSomeUncovered = 1, kSomeCovered = 2;
-  tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
-    std::vector<uint8_t> hintBlocks(width);  // what each block of the hint holds, row by row
-    for (int y = r.begin(); y < r.end(); ++y) {
-      if (hint) {
-        std::fill(hintBlocks.begin(), hintBlocks.end(), uint8_t{0});
-        for (int j = y * s; j < (y + 1) * s; ++j) {
-          const float* row = &hint->pixels[static_cast<size_t>(j) * hint->width];
-          for (int x = 0; x < width; ++x) {
-            uint8_t seen = 0;
-            for (int i = x * s; i < (x + 1) * s; ++i)
-              seen |= row[i] > 0.5f ? kSomeCovered : kSomeUncovered;
-            hintBlocks[x] |= seen;
-          }
-        }
-      }
-      for (int x = 0; x < width; ++x) {
-        const size_t p = static_cast<size_t>(y) * width + x;
-        if (refine[p]) continue;
-        bool differs = hint && hintBlocks[x] != (covered[p] ? kSomeCovered : kSomeUncovered);
-        for (int dy = -1; dy <= 1 && !differs; ++dy) {
-          for (int dx = -1; dx <= 1 && !differs; ++dx) {
-            int nx = x + dx, ny = y + dy;
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-            differs = covered[static_cast<size_t>(ny) * width + nx] != covered[p];
-          }
-        }
-        refine[p] = differs;
-      }
-    }
-  });
-  return refine;
-}
-
-metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,
-                                     const CancelToken& cancel) {
-  return [scene, &camera, &cancel](const std::vector<Vec2>& points, std::vector<char>& covered) {
-    castCoverageAt(scene, camera, points, covered, cancel);
-  };
-}
 
 // Moves every primary hit onto the limit surface (Newton) and writes the passes; counts hits
 // and failures into result.stats, and warns about the wireframe and about many failures.

@@ -13,6 +13,7 @@
 #include "render/core/cancel.h"
 #include "render/core/image.h"
 #include "render/core/passes.h"
+#include "render/implicit/polygonize.h"
 #include "render/mesh/control_mesh.h"
 #include "render/metrics/metrics.h"
 #include "render/oracle/reference.h"
@@ -67,6 +68,11 @@ struct JobLimits {
   int maxSearchSteps = 30;
   int maxCurveSamples = 256;
   size_t maxTriangles = 8'000'000;
+  // Implicit fields (runImplicit): primitives per field, polygonizer.resolution, characters of a
+  // custom expression (its cost per evaluation is linear in its length).
+  int maxPrimitives = 64;
+  int maxResolution = 512;
+  size_t maxExpressionLength = 256;
 };
 
 struct RenderJob {
@@ -94,6 +100,14 @@ struct Stats {
   // The silhouette method's own counts (absent for other methods).
   std::optional<silhouette::SilhouetteStats> silhouette;
   bool presubdivided = false;
+  // Implicit jobs: what the polygoniser did and how closed its mesh is.
+  struct Implicit {
+    size_t primitives = 0;
+    implicit::PolygonizerMethod method = implicit::PolygonizerMethod::MarchingCubes;
+    implicit::PolygonizerStats polygonizer;
+    implicit::MeshClosure closure;
+  };
+  std::optional<Implicit> implicit;
 };
 
 struct Timings {

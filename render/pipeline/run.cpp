@@ -8,6 +8,7 @@
 #include "render/oracle/reference.h"
 #include "render/pipeline/approximation.h"
 #include "render/pipeline/job_checks.h"
+#include "render/pipeline/measure.h"
 #include "render/pipeline/render_job.h"
 #include "render/pipeline/silhouette_build.h"
 #include "render/raster/rasterizer.h"
@@ -132,29 +133,6 @@ silhouette::SilhouetteMesh runSilhouette(const RenderJob& job, const JobLimits& 
   result.stats.presubdivided = drawn != nullptr;
   result.stats.silhouette = build.built.stats;
   return std::move(build.built);
-}
-
-// Keeps only the passes the client asked for; the wireframe of the reference is its colour
-// (the exact surface has no edges to draw).
-ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference) {
-  ImageSet selected;
-  auto keep = [&](bool wanted, const char* name) {
-    if (!wanted) return;
-    auto it = images.passes.find(name);
-    if (it != images.passes.end()) selected.passes[name] = std::move(it->second);
-  };
-  if (isReference && outputs.wireframe && images.passes.count(pass::kColor)) {
-    selected.passes[pass::kWireframe] = images.passes[pass::kColor];
-  }
-  keep(outputs.color, pass::kColor);
-  keep(outputs.mask, pass::kMask);
-  keep(outputs.depth, pass::kDepth);
-  keep(outputs.normal, pass::kNormal);
-  if (!isReference) keep(outputs.wireframe, pass::kWireframe);
-  if (!isReference) keep(outputs.contours, pass::kContours);
-  if (!isReference) keep(outputs.cage, pass::kCage);
-  if (!isReference) keep(outputs.diff, pass::kDiff);
-  return selected;
 }
 
 // The independent check: Embree's own subdivision geometry against the reference's mask and
@@ -335,26 +313,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     cancel.check();
 
     if (measure) {
-      const ImageSet& approxImages = result.images;
-      const ImageSet& refImages = reference.images;
-      result.metrics.silhouette = metrics::compareSilhouettes(
-          approxImages.supersampledMask, refImages.supersampledMask, S, cancel);
-      // The reference was hinted with this mask: its refined pixels hold all of its outline.
-      metrics::Outline outline = oracle::locateMeshOutline(
-          *approx, camera, approxImages.supersampledMask, S, cancel, &reference.refinedPixels);
-      metrics::OutlineDistances d = metrics::compareOutlines(
-          outline, reference.outline, std::hypot(camera.width(), camera.height()));
-      result.metrics.silhouette->outlineHausdorffPx = d.hausdorffPx;
-      result.metrics.silhouette->outlineMeanPx = d.meanPx;
-      result.metrics.image = metrics::compareColor(approxImages, refImages);
-      result.metrics.depth =
-          metrics::compareDepth(approxImages, refImages, surface.bounds().diagonal());
-      result.metrics.normal = metrics::compareNormals(approxImages, refImages);
-      if (job.outputs.diff) {
-        metrics::DiffImage diff = metrics::colorDifference(approxImages, refImages);
-        result.metrics.image->diffScale = diff.scale;
-        result.images.passes[pass::kDiff] = std::move(diff.image);
-      }
+      measureAgainstReference(*approx, camera, S, reference, surface.bounds().diagonal(),
+                              job.outputs.diff, cancel, result);
     }
     if (job.method == Method::Limit) {
       result.images = selectOutputs(reference.images, job.outputs, true);

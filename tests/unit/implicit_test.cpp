@@ -125,7 +125,7 @@ TEST(ImplicitField, ExpressionsMayOnlyUseXyz) {
     FieldSpec spec{{primitive(PrimitiveType::Soft, {0, 0, 0}, 1), p}, 0.5};
     EXPECT_THROW(Field{spec}, InputError) << bad;
   }
-  Primitive cut = primitive(PrimitiveType::Expression, {0, 0, 0}, 1, 20.0, true);
+  Primitive cut = primitive(PrimitiveType::Expression, {0, 0, 0}, 1, 400.0, true);
   cut.expression = "x^2 + y^2 - 0.04";
   Field f({{primitive(PrimitiveType::Soft, {0, 0, 0}, 2), cut}, 0.5});
   FieldEvaluator e(f);

@@ -1,0 +1,70 @@
+// What both references (the limit surface's and the implicit surface's) do the same way: the
+// shaded passes written pixel by pixel, the choice of pixels whose supersampled mask is cast in
+// full, and a coverage query on a scene for the outline search.
+#pragma once
+
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/core/image.h"
+#include "render/core/passes.h"
+#include "render/core/shading.h"
+#include "render/metrics/outline.h"
+#include "render/oracle/embree_device.h"
+#include "render/oracle/surface_hit.h"
+
+namespace limn::render::oracle {
+
+// The output images of the selected passes, filled pixel by pixel.
+struct PassImages {
+  Image* color = nullptr;
+  Image* mask = nullptr;
+  Image* depth = nullptr;
+  Image* normal = nullptr;
+
+  PassImages(ImageSet& set, const PassSelection& passes, int width, int height) {
+    if (passes.color || passes.wireframe) {
+      color = &set.passes[pass::kColor];
+      *color = Image(width, height, 4);
+      for (size_t i = 0; i < color->pixels.size(); i += 4) {
+        for (int c = 0; c < 3; ++c) color->pixels[i + c] = shading::kBackground[c];
+        color->pixels[i + 3] = 0.0f;
+      }
+    }
+    if (passes.mask) mask = &(set.passes[pass::kMask] = Image(width, height, 1));
+    if (passes.depth) depth = &(set.passes[pass::kDepth] = Image(width, height, 1));
+    if (passes.normal) normal = &(set.passes[pass::kNormal] = Image(width, height, 3));
+  }
+
+  void write(int x, int y, const SurfaceHit& hit, const Camera& camera) {
+    if (mask) mask->at(x, y) = 1.0f;
+    if (depth) depth->at(x, y) = static_cast<float>(camera.depthOf(hit.position));
+    if (normal) {
+      normal->at(x, y, 0) = static_cast<float>(hit.normal.x);
+      normal->at(x, y, 1) = static_cast<float>(hit.normal.y);
+      normal->at(x, y, 2) = static_cast<float>(hit.normal.z);
+    }
+    if (color) {
+      Vec3 toEye = camera.projection() == Projection::Perspective
+                       ? normalize(camera.eye() - hit.position)
+                       : -camera.forward();
+      float rgb[3];
+      shading::shade(hit.normal, toEye, rgb);
+      for (int c = 0; c < 3; ++c) color->at(x, y, c) = rgb[c];
+      color->at(x, y, 3) = 1.0f;
+    }
+  }
+};
+
+// Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
+// `refine` (outline candidates known beforehand), those with an 8-neighbour of other coverage,
+// and those where the hint's block is mixed or disagrees with the pixel.
+std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
+                                 int width, int height, const Image* hint, int s);
+
+// Coverage at image-plane points by occlusion rays into `scene`.
+metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,
+                                     const CancelToken& cancel);
+
+}  // namespace limn::render::oracle

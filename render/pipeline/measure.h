@@ -1,0 +1,24 @@
+// The steps every kind of job (a control mesh or an implicit field) ends with: an approximation's
+// images measured against its reference, and the answer's passes picked from what was rendered.
+#pragma once
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/oracle/reference.h"
+#include "render/pipeline/render_job.h"
+#include "render/tessellate/triangle_mesh.h"
+
+namespace limn::render::pipeline {
+
+// result.images (the approximation's passes at supersample S) against `reference` (cast with the
+// approximation's mask as its hint): silhouette metrics with the continuous outline distances,
+// colour, depth (relative to `diagonal`) and normal metrics, and the diff image when asked.
+void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camera& camera, int S,
+                             const oracle::ReferenceResult& reference, double diagonal, bool diff,
+                             const CancelToken& cancel, RenderResult& result);
+
+// Keeps only the passes the client asked for; the wireframe of the reference is its colour
+// (the exact surface has no edges to draw).
+ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference);
+
+}  // namespace limn::render::pipeline
