@@ -7,11 +7,13 @@ packages=(
   cmake ninja-build g++ pkg-config
   libembree-dev libosd-dev libopenimageio-dev openimageio-tools libboost-dev rapidjson-dev
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev curl
+  libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev libmuparser-dev curl
   # the quality gates: clang with its sanitizer runtimes and libFuzzer (scripts/sanitize.sh,
   # scripts/fuzz.sh), Prometheus' text-format parser and a JSON Schema validator (the /metrics and
   # OpenAPI tests), the load generator
   clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
+  # the implicit-surface benchmark's baseline (bench/implicit_vs_skimage.py)
+  python3-skimage
 )
 
 # The browser tests (tests/browser): Debian's chromium, and node + npm unless a node is there.
