@@ -183,8 +183,7 @@ Polygonization polygonize(const Field& field, const PolygonizerOptions& options,
   checkOptions(options);
   const double tolerance = options.epsilon * field.bounds().diagonal();
   const bool adaptive = options.method == PolygonizerMethod::Adaptive;
-  const Grid grid =
-      makeGrid(field.bounds(), adaptive ? std::max(4, options.resolution / 4) : options.resolution);
+  const Grid grid = makeGrid(field.bounds(), options.resolution);
   Polygonization result;
   PolygonizerStats& stats = result.stats;
   for (int a = 0; a < 3; ++a) stats.gridCells[a] = grid.n[a];

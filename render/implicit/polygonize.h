@@ -9,7 +9,8 @@
 //                   differ by more than `flatness`), down to the grid's cell size, polygonised by
 //                   dual marching cubes (each octree vertex's cell of leaf centres), which is
 //                   closed by construction across cells of different sizes;
-//   adaptive        a marching-cubes mesh at a quarter of `resolution`, whose edges are split
+//   adaptive        a marching-cubes mesh at `resolution` (coarse: it sets what topology is
+//                   found), whose edges are split
 //                   where the normals at their ends differ by more than `flatness` (up to
 //                   `maxDepth` times), the new vertices moved onto the surface; triangles with
 //                   one, two or three split edges become two, three or four, so no T-junction
