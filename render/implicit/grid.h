@@ -65,6 +65,7 @@ class LayerMarcher {
   const Grid& grid_;
   RawMesh& out_;
   std::vector<uint32_t> xBottom_, xTop_, yBottom_, yTop_, z_;
+  std::vector<uint8_t> columns_;
   size_t cellsWithSurface_ = 0;
 };
 

@@ -59,15 +59,27 @@ void LayerMarcher::march(int k, const float* bottom, const float* top) {
   const CubeTable& table = CubeTable::instance();
   const auto& edges = cubeEdges();
   std::fill(z_.begin(), z_.end(), kNone);
+  // Per column of corners (x = i) of a row of cells: the inside bits of its four corners at the
+  // places they take in a cube's configuration (bits 0, 2, 4, 6: y0z0, y1z0, y0z1, y1z1), so a
+  // cell's configuration is column[i] | column[i + 1] << 1, and empty cells cost two loads.
+  columns_.resize(stride);
   for (int j = 0; j < ny; ++j) {
+    const float* b0 = bottom + j * stride;
+    const float* b1 = b0 + stride;
+    const float* t0 = top + j * stride;
+    const float* t1 = t0 + stride;
+    for (size_t i = 0; i < stride; ++i) {
+      columns_[i] = static_cast<uint8_t>((b0[i] > 0.0f) | (b1[i] > 0.0f) << 2 |
+                                         (t0[i] > 0.0f) << 4 | (t1[i] > 0.0f) << 6);
+    }
     for (int i = 0; i < nx; ++i) {
+      const int configuration = columns_[i] | columns_[i + 1] << 1;
+      if (configuration == 0 || configuration == 255) continue;
+      ++cellsWithSurface_;
       const size_t c00 = j * stride + i;
       const float v[8] = {
           bottom[c00], bottom[c00 + 1], bottom[c00 + stride], bottom[c00 + stride + 1],
           top[c00],    top[c00 + 1],    top[c00 + stride],    top[c00 + stride + 1]};
-      const int configuration = cubeConfiguration(v);
-      if (configuration == 0 || configuration == 255) continue;
-      ++cellsWithSurface_;
       const std::vector<uint8_t>& triangles = table.triangles(configuration);
       for (uint8_t e : triangles) {
         // The slot of edge e of cell (i, j) among the two layers' edge arrays.

@@ -1,0 +1,176 @@
+// The polygonisers on the sample scenes of configs/implicit: time, triangles, vertices and
+// geometric error per method and resolution, and the adaptive-vs-finer-grid comparison.
+//
+//   implicit_bench [--resolutions 80,120,360] [--scenes a,b]     the tables
+//   (bench/implicit_results.md) implicit_bench --dump SCENE RESOLUTION FILE                  for
+//   bench/implicit_vs_skimage.py:
+//       samples the field on the marching-cubes grid (all threads; timed), writes it to FILE as
+//       float32 [z][y][x], runs marching cubes on the samples on one thread (best of 5; vertices
+//       by linear interpolation, as scikit-image places them) and prints one JSON line.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "api/implicit_api.h"
+#include "bench/bench_common.h"
+#include "render/implicit/grid.h"
+#include "render/implicit/polygonize.h"
+
+namespace {
+
+using namespace limn;
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+render::implicit::FieldSpec sceneField(const std::string& name) {
+  std::ifstream in(std::string(LIMN_SOURCE_DIR) + "/configs/implicit/" + name + ".json");
+  if (!in) throw std::runtime_error("no scene configs/implicit/" + name + ".json");
+  std::stringstream text;
+  text << in.rdbuf();
+  return api::parseImplicitRequest(text.str(), {}).job.field;
+}
+
+struct Row {
+  double ms = 0;
+  size_t triangles = 0, vertices = 0;
+  render::implicit::ImplicitGeometryError error;
+  bool closed = false;
+};
+
+Row polygonise(const render::implicit::Field& field, render::implicit::PolygonizerMethod method,
+               int resolution, double flatness = 0.9) {
+  render::implicit::PolygonizerOptions options;
+  options.method = method;
+  options.resolution = resolution;
+  options.flatness = flatness;
+  Row best;
+  for (int run = 0; run < 3; ++run) {
+    const auto start = Clock::now();
+    render::implicit::Polygonization p = render::implicit::polygonize(field, options, {});
+    const double ms = msSince(start);
+    if (run == 0 || ms < best.ms) {
+      best.ms = ms;
+      best.triangles = p.mesh.triangleCount();
+      best.vertices = p.mesh.vertexCount();
+      best.error = render::implicit::measureImplicitGeometry(p.mesh, field, {});
+      best.closed = render::implicit::checkClosure(p.mesh).closed();
+    }
+    if (ms > 2000) break;  // large grids: one run is enough
+  }
+  return best;
+}
+
+void printRow(const std::string& scene, const char* method, int resolution, const char* extra,
+              const Row& r) {
+  std::printf("| %s | %s%s | %d | %.1f | %zu | %zu | %.2e | %.2e | %s |\n", scene.c_str(), method,
+              extra, resolution, r.ms, r.triangles, r.vertices, r.error.relMaxDist,
+              r.error.relMeanDist, r.closed ? "yes" : "**no**");
+}
+
+int tables(const std::vector<std::string>& scenes, const std::vector<int>& resolutions) {
+  using render::implicit::PolygonizerMethod;
+  const PolygonizerMethod methods[] = {PolygonizerMethod::MarchingCubes, PolygonizerMethod::Tracker,
+                                       PolygonizerMethod::Octree, PolygonizerMethod::Adaptive};
+  std::printf(
+      "| scene | method | resolution | ms | triangles | vertices | max error | mean error "
+      "| closed |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n");
+  for (const std::string& scene : scenes) {
+    const render::implicit::Field field(sceneField(scene));
+    for (int resolution : resolutions) {
+      for (PolygonizerMethod method : methods) {
+        printRow(scene, render::implicit::polygonizerName(method), resolution, "",
+                 polygonise(field, method, resolution));
+        std::fflush(stdout);
+      }
+    }
+  }
+  // Adaptive from a coarse grid with a strict flatness against plain marching cubes on finer
+  // grids: the finest grid whose mean error adaptive matches, and the triangle ratio.
+  std::printf(
+      "\n| scene | adaptive (resolution, flatness) | triangles | mean error | finest "
+      "marching-cubes grid it matches | its triangles | ratio |\n"
+      "|---|---|---:|---:|---:|---:|---:|\n");
+  for (const std::string& scene : scenes) {
+    const render::implicit::Field field(sceneField(scene));
+    for (double flatness : {0.97, 0.99}) {
+      const Row adaptive = polygonise(field, PolygonizerMethod::Adaptive, 60, flatness);
+      Row matched;
+      int matchedResolution = 0;
+      for (int resolution = 60; resolution <= 480; resolution += 20) {
+        Row mc = polygonise(field, PolygonizerMethod::MarchingCubes, resolution);
+        if (mc.error.relMeanDist < adaptive.error.relMeanDist) break;
+        matched = mc;
+        matchedResolution = resolution;
+      }
+      std::printf("| %s | 60, %.2f | %zu | %.2e | %d | %zu | %.2f |\n", scene.c_str(), flatness,
+                  adaptive.triangles, adaptive.error.relMeanDist, matchedResolution,
+                  matched.triangles,
+                  matched.triangles ? double(adaptive.triangles) / matched.triangles : 0.0);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
+int dump(const std::string& scene, int resolution, const std::string& path) {
+  const render::implicit::Field field(sceneField(scene));
+  const render::implicit::Grid grid = render::implicit::makeGrid(field.bounds(), resolution);
+  const size_t perLayer = grid.cornersPerLayer();
+  std::vector<float> values(perLayer * (grid.n[2] + 1));
+  auto start = Clock::now();
+  render::implicit::sampleLayers(field, grid, 0, grid.n[2], values.data(), {});
+  const double sampleMs = msSince(start);
+  double best = 1e300;
+  size_t triangles = 0;
+  for (int run = 0; run < 5; ++run) {
+    render::implicit::RawMesh raw;
+    start = Clock::now();
+    render::implicit::LayerMarcher marcher(grid, raw);
+    for (int k = 0; k < grid.n[2]; ++k) {
+      marcher.march(k, &values[k * perLayer], &values[(k + 1) * perLayer]);
+    }
+    // Vertex positions by linear interpolation, as scikit-image computes them.
+    std::vector<render::Vec3f> positions(raw.vertices.size());
+    for (size_t v = 0; v < raw.vertices.size(); ++v) {
+      const auto& e = raw.vertices[v];
+      const double t = e.fa / (e.fa - e.fb);
+      positions[v] = render::Vec3f(e.a + (e.b - e.a) * t);
+    }
+    best = std::min(best, msSince(start));
+    triangles = raw.indices.size() / 3;
+  }
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(values.data()),
+            static_cast<std::streamsize>(values.size() * sizeof(float)));
+  std::printf(
+      "{\"scene\":\"%s\",\"resolution\":%d,\"shape\":[%d,%d,%d],\"sampleMs\":%.3f,"
+      "\"mvoxelsPerS\":%.2f,\"mcMs\":%.3f,\"triangles\":%zu}\n",
+      scene.c_str(), resolution, grid.n[2] + 1, grid.n[1] + 1, grid.n[0] + 1, sampleMs,
+      values.size() / (sampleMs * 1e3), best, triangles);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> scenes = {"sphere_bite", "metaball_figure", "sphere_cylinder_cut"};
+  std::vector<int> resolutions = {80, 120, 360};
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--dump" && i + 3 < argc)
+      return dump(argv[i + 1], std::stoi(argv[i + 2]), argv[i + 3]);
+    if (arg == "--scenes" && i + 1 < argc) scenes = bench::splitList(argv[++i]);
+    if (arg == "--resolutions" && i + 1 < argc) {
+      resolutions.clear();
+      for (const std::string& r : bench::splitList(argv[++i])) resolutions.push_back(std::stoi(r));
+    }
+  }
+  return tables(scenes, resolutions);
+}
