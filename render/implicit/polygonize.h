@@ -37,7 +37,7 @@ struct PolygonizerOptions {
   PolygonizerMethod method = PolygonizerMethod::MarchingCubes;
   int resolution = 80;    // cells along the longest side of the domain
   double flatness = 0.9;  // octree, adaptive: cosine between normals below which to refine
-  double epsilon = 1e-4;  // root-finding and projection tolerance, relative to the diagonal
+  double epsilon = 1e-6;  // root-finding and projection tolerance, relative to the diagonal
   int maxDepth = 3;       // adaptive: rounds of edge splitting
   size_t maxTriangles = 8'000'000;
 };
