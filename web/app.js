@@ -1,6 +1,6 @@
-// limn's page: pick or upload a mesh, choose a method and what to draw, orbit the camera, and
-// compare the approximation with the exact reference. Every picture comes from the server
-// (POST /v1/render); while the camera is dragged the page draws the approximation's triangles
+// limn's page: pick or upload a mesh (or an implicit scene), choose a method and what to draw,
+// orbit the camera, and compare the approximation with the exact reference. Every picture comes
+// from the server (POST /v1/render; POST /v1/implicit for scenes); while the camera is dragged the page draws the approximation's triangles
 // itself (POST /v1/tessellate, WebGL 2: glview.js), or, without WebGL or before they arrive,
 // shows small renders, and the full-size picture follows when the drag ends. See docs/web.md.
 import { ApiProblem, UploadedMesh, getJson, getText, post, postBinary } from "/api.js";
@@ -47,7 +47,14 @@ const state = {
   frame: null,          // {target, radius, fovYDeg} of the mesh, from the last answer's camera
   glView: null,         // MeshView, when the browser has WebGL 2
   tessellation: null,   // AbortController of the POST /v1/tessellate in flight
+  scene: null,          // an implicit scene ({field, ...}: a /v1/implicit request) instead of a mesh
 };
+
+// An implicit scene sent whole with every request; it stands where an UploadedMesh would.
+class SceneSource {
+  constructor(request) { this.request = request; this.id = null; }
+  withId(request) { return request(null); }
+}
 
 // ---------------------------------------------------------------- errors next to controls
 
@@ -101,12 +108,22 @@ function cameraFor(size) {
 function renderBody(mesh, size, compare) {
   const outputs = [mainOutput()];
   if (compare) outputs.push("diff");
+  if (state.scene) {
+    return { field: state.scene.field, camera: cameraFor(size), outputs, reference: compare,
+             shading: $("shading").value === "flat" ? "flat" : "smooth",
+             polygonizer: { method: $("polygonizer").value, resolution: Number($("resolution").value),
+                            flatness: Number($("flatness").value) } };
+  }
   return { mesh, camera: cameraFor(size), method: $("method").value, params: methodParams(),
            shading: $("shading").value, outputs, reference: compare };
 }
 
+// Where the page's renders go: meshes to /v1/render, implicit scenes to /v1/implicit.
+const renderPath = () => (state.scene ? "/v1/implicit" : "/v1/render");
+
 const fullSize = () => Number($("size").value);
-const comparing = () => $("compare").checked && $("method").value !== "limit";
+const comparing = () =>
+  $("compare").checked && (state.scene !== null || $("method").value !== "limit");
 
 // ---------------------------------------------------------------- rendering
 
@@ -131,7 +148,7 @@ async function renderFull() {
   const contours = $("draw-contours").checked ? loadContours(controller.signal) : null;
   try {
     const answer = await state.mesh.withId(
-        (mesh) => post("/v1/render", renderBody(mesh, fullSize(), compare),
+        (mesh) => post(renderPath(), renderBody(mesh, fullSize(), compare),
                        { signal: controller.signal }),
         controller.signal);
     if (controller.signal.aborted) return;
@@ -172,7 +189,8 @@ async function showAnswer(answer, compare) {
   drawClientCage(answer.camera);
   const s = answer.stats, t = answer.timings;
   $("stats").textContent = `${s.triangles.toLocaleString("en")} triangles · ` +
-      `${s.controlFaces} control faces · ${t.totalMs.toFixed(0)} ms`;
+      (state.scene ? `${s.closed ? "closed" : "not closed"} · ${s.implicit.primitives} primitives`
+                   : `${s.controlFaces} control faces`) + ` · ${t.totalMs.toFixed(0)} ms`;
   $("stats").dataset.triangles = String(s.triangles);
   document.body.classList.toggle("comparing", compare);
   if (compare) {
@@ -196,7 +214,7 @@ async function renderPreview() {
   try {
     const size = Math.max(64, Math.round(fullSize() / PREVIEW_DIVISOR));
     const answer = await state.mesh.withId(
-        (mesh) => post("/v1/render", renderBody(mesh, size, false)));
+        (mesh) => post(renderPath(), renderBody(mesh, size, false)));
     if ((state.dragging || state.full === null) && $("gl-canvas").hidden) {
       await showImage($("picture"), answer.images[mainOutput()] || answer.images.color);
       drawClientCage(answer.camera);
@@ -249,7 +267,7 @@ const tessellationKey = () =>
 
 async function loadTessellation(triangles) {
   const view = state.glView;
-  if (!view || !state.mesh) return;
+  if (!view || !state.mesh || state.scene) return;  // scenes are previewed by small renders
   const key = tessellationKey();
   if (view.key === key || $("method").value === "limit" || triangles > LOCAL_MAX_TRIANGLES) return;
   state.tessellation?.abort();
@@ -458,8 +476,49 @@ function wireMesh(source) {
   return { format: "obj", data, scheme };
 }
 
+// Shows the mesh controls or the implicit scene's polygoniser controls.
+function showSourceControls() {
+  const scene = Boolean(state.scene);
+  $("polygonizer-params").hidden = !scene;
+  for (const id of ["method", "scheme", "boundary", "crease-method"]) {
+    $(id).closest("label").hidden = scene;
+  }
+  if (scene) {
+    for (const group of document.querySelectorAll(".params")) group.hidden = true;
+  } else {
+    showMethodParams();
+  }
+  $("draw-contours").disabled = $("draw-cage").disabled = scene;
+  $("reference-caption").textContent =
+      `exact reference (ray-cast ${scene ? "isosurface" : "limit surface"})`;
+}
+
+// An implicit scene: a /v1/implicit request whose field (and polygonizer, as defaults for the
+// controls) the page sends with its own camera, outputs and comparison.
+async function useScene(request, label) {
+  state.full?.abort();
+  state.scene = request;
+  state.mesh = new SceneSource(request);
+  state.meshText = null;
+  state.frame = null;
+  if (state.glView) state.glView.setCage([], []);
+  const polygonizer = request.polygonizer || {};
+  if (polygonizer.method) $("polygonizer").value = polygonizer.method;
+  if (polygonizer.resolution) $("resolution").value = polygonizer.resolution;
+  if (polygonizer.flatness !== undefined) $("flatness").value = polygonizer.flatness;
+  $("draw-contours").checked = $("draw-cage").checked = false;
+  showSourceControls();
+  clearErrors();
+  hideContours();
+  $("mesh-info").textContent = `${label}: implicit field of ${request.field.primitives.length} ` +
+      `primitives, iso ${request.field.iso ?? 0.5}`;
+  await renderFull();
+}
+
 async function useMesh(source, label) {
   state.full?.abort();
+  state.scene = null;
+  showSourceControls();
   state.meshText = source;
   state.mesh = new UploadedMesh(wireMesh(source));
   state.frame = null;  // until the first answer for this mesh
@@ -486,6 +545,13 @@ async function useMesh(source, label) {
 }
 
 async function loadExample(name) {
+  if (name.startsWith("scene:")) {
+    const scene = name.slice("scene:".length);
+    state.view = { ...DEFAULT_VIEW };
+    describeView();
+    await useScene(await getJson(`/scenes/${encodeURIComponent(scene)}`), scene);
+    return;
+  }
   const example = state.examples.find((e) => e.name === name);
   if (!example) return;
   $("scheme").value = example.scheme;
@@ -502,6 +568,11 @@ async function loadFile(file) {
   if (/\.json$/i.test(file.name) || /^\s*\{/.test(text)) {
     try {
       const parsed = JSON.parse(text);
+      if (parsed.field) {  // a /v1/implicit request
+        $("example").value = "";
+        await useScene(parsed, file.name);
+        return;
+      }
       source = parsed.mesh || parsed;  // a whole /v1/render request, or a JSON mesh
     } catch (error) {
       showError(new ApiProblem(400, { error: { message: `${file.name} is not JSON: ${error.message}`,
@@ -625,7 +696,8 @@ function bindControls() {
   $("level").addEventListener("input", () => { $("level-value").textContent = $("level").value; });
   $("method").addEventListener("change", showMethodParams);
   for (const id of ["method", "level", "engine", "dicing-rate", "contour-mode", "presubdivide",
-                    "draw-surface", "draw-cage", "draw-wireframe", "shading", "size"]) {
+                    "draw-surface", "draw-cage", "draw-wireframe", "shading", "size",
+                    "polygonizer", "resolution", "flatness"]) {
     $(id).addEventListener("change", renderFull);
   }
   $("draw-contours").addEventListener("change", () => {
@@ -661,6 +733,12 @@ async function start() {
     return;
   }
   for (const e of state.examples) $("example").add(new Option(e.title, e.name));
+  try {
+    const scenes = await getJson("/scenes");
+    for (const name of scenes) $("example").add(new Option(`implicit: ${name}`, `scene:${name}`));
+  } catch (problem) {
+    console.warn("no implicit scenes:", problem.message);
+  }
   $("example").add(new Option("(uploaded file)", ""));
   const first = options.get("example") || "torus_creased";
   $("example").value = first;

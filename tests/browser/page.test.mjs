@@ -336,4 +336,36 @@ describe("limn's page", () => {
     await page.check("input[value=slider]");
     await shot("compare-slider", page.locator("#approx-panel"));
   });
+  it("renders an implicit scene, with its polygoniser and the reference", async () => {
+    const options = await page.$$eval("#example option", (os) => os.map((o) => o.value));
+    assert.ok(options.includes("scene:metaball_figure"), `no implicit scenes in ${options}`);
+    const before = await page.evaluate(() => window.limnPage.renders);
+    await page.selectOption("#example", "scene:metaball_figure");
+    await waitForRenders(before + 1);
+    assert.ok(await page.isVisible("#polygonizer"), "the polygoniser controls are hidden");
+    assert.ok(!(await page.isVisible("#method")), "the mesh method control still shows");
+    assert.match(await page.textContent("#mesh-info"), /implicit field of 12 primitives/);
+    assert.match(await page.textContent("#stats"), /closed · 12 primitives/);
+    assert.ok(await inkFraction("#picture") > 0.02, "the scene's picture is blank");
+    const answer = await page.evaluate(() => window.limnPage.lastAnswer);
+    assert.equal(answer.stats.implicit.polygonizer, "marching-cubes");
+    if (await page.$eval("#compare", (el) => el.checked)) {
+      assert.ok(answer.metrics.silhouette.hausdorffPx <= 1.0,
+                `${answer.metrics.silhouette.hausdorffPx} px from the reference`);
+    }
+    const marched = await triangles();
+    const n = await set("#polygonizer", "octree");
+    await waitForRenders(n + 1);
+    const octree = await page.evaluate(() => window.limnPage.lastAnswer.stats);
+    assert.equal(octree.implicit.polygonizer, "octree");
+    assert.ok(octree.closed, "the octree mesh is not closed");
+    assert.notEqual(await triangles(), marched, "the polygoniser did not change the mesh");
+    await shot("implicit-scene");
+    // Back to a mesh: its controls return.
+    const m = await page.evaluate(() => window.limnPage.renders);
+    await page.selectOption("#example", "cube");
+    await waitForRenders(m + 1);
+    assert.ok(await page.isVisible("#method"), "the method control did not come back");
+    assert.ok(!(await page.isVisible("#polygonizer")), "the polygoniser controls stayed");
+  });
 });
