@@ -59,6 +59,11 @@ Usage:
   limn help | --help      this text
   limn --version          the version
 
+Environment (for containers; a command-line option wins over its variable):
+  LIMN_CONFIG=FILE        the configuration file when there is no --config
+  LIMN_LISTEN=HOST:PORT   limn serve's address when there is no --listen (over the file's)
+  LIMN_AUTH_TOKEN=TOKEN   the bearer token when the configuration file sets none
+
 Exit status: 0 success, 1 usage or configuration error, 2 bad request, 3 render failure.
 )";
 
@@ -121,14 +126,24 @@ std::optional<CommandLine> parseArguments(int argc, char** argv, int first, std:
   return cl;
 }
 
+// The value of an environment variable, or nothing when it is unset or empty.
+std::optional<std::string> environment(const char* name) {
+  const char* value = std::getenv(name);
+  if (!value || !*value) return std::nullopt;
+  return std::string(value);
+}
+
+// --config FILE, else LIMN_CONFIG (a container image sets the variable once and mounts the
+// file, so that its command line need not be overridden), else the built-in defaults.
 std::optional<api::ServiceConfig> loadConfiguration(const CommandLine& cl) {
-  if (!cl.config) return api::ServiceConfig{};
+  std::optional<std::string> path = cl.config ? cl.config : environment("LIMN_CONFIG");
+  if (!path) return api::ServiceConfig{};
   try {
-    return api::loadConfig(*cl.config);
+    return api::loadConfig(*path);
   } catch (const api::ApiError& e) {
-    std::cerr << "limn: configuration " << *cl.config << ": " << e.message << "\n";
+    std::cerr << "limn: configuration " << *path << ": " << e.message << "\n";
   } catch (const std::exception& e) {
-    std::cerr << "limn: configuration " << *cl.config << ": " << e.what() << "\n";
+    std::cerr << "limn: configuration " << *path << ": " << e.what() << "\n";
   }
   return std::nullopt;
 }
@@ -138,11 +153,16 @@ int serve(const CommandLine& cl) {
   auto config = loadConfiguration(cl);
   if (!config) return 1;
   if (cl.out) return usageError("--out belongs to limn render");
-  if (cl.listen) {
+  // --listen, else LIMN_LISTEN (a container listens on all interfaces, a developer's machine
+  // on loopback: the image sets the variable, the file keeps its default), else the file's.
+  const char* listenName = "--listen";
+  std::optional<std::string> listen = cl.listen;
+  if (!listen && (listen = environment("LIMN_LISTEN"))) listenName = "LIMN_LISTEN";
+  if (listen) {
     std::string host;
     unsigned short port = 0;
-    if (!parseListen(*cl.listen, host, port)) {
-      return usageError("--listen wants HOST:PORT, got " + *cl.listen);
+    if (!parseListen(*listen, host, port)) {
+      return usageError(std::string(listenName) + " wants HOST:PORT, got " + *listen);
     }
     config->host = host;
     config->port = port;

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 
+#include "tests/integration/http_client.h"
 #include "tests/integration/server_process.h"
 
 namespace limn::testing {
@@ -111,11 +112,68 @@ TEST_F(CliTest, UsageErrorsExit1) {
   EXPECT_NE(badConfig.err.find("wrokers"), std::string::npos) << badConfig.err;
 }
 
+// Sets an environment variable for one scope (the servers a test starts inherit it).
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const std::string& value) : name_(name) {
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnvironment() { ::unsetenv(name_); }
+  ScopedEnvironment(const ScopedEnvironment&) = delete;
+  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+ private:
+  const char* name_;
+};
+
+// What a container image relies on: LIMN_CONFIG names the file and LIMN_LISTEN the address
+// when the command line does not, and the command line wins when it does.
+TEST_F(CliTest, ServeTakesItsConfigurationAndAddressFromTheEnvironment) {
+  ScopedEnvironment config("LIMN_CONFIG",
+                           write("env.json", R"({"workers": 1, "queueDepth": 3})").string());
+  // Another loopback address than the harness's 127.0.0.1, so that it is seen to be used.
+  ScopedEnvironment listen("LIMN_LISTEN", "127.0.0.2:0");
+  {
+    ServerProcess server({}, std::chrono::seconds(60), /*loopbackListen=*/false);
+    EXPECT_EQ(server.host(), "127.0.0.2");
+    HttpClient client(server.port(), server.host());
+    HttpResponse health = client.request("GET", "/healthz");
+    EXPECT_EQ(health.status, 200);
+    EXPECT_NE(health.body.find("\"workers\":1,"), std::string::npos) << health.body;
+    EXPECT_NE(health.body.find("\"queueCapacity\":3,"), std::string::npos) << health.body;
+    EXPECT_EQ(server.terminate(), 0);
+  }
+  {
+    ServerProcess server({"--config", write("flag.json", R"({"workers": 2})").string()});
+    EXPECT_EQ(server.host(), "127.0.0.1") << "--listen wins over LIMN_LISTEN";
+    HttpResponse health = get(server.port(), "/healthz");
+    EXPECT_NE(health.body.find("\"workers\":2,"), std::string::npos)
+        << "--config wins over LIMN_CONFIG: " << health.body;
+    EXPECT_EQ(server.terminate(), 0);
+  }
+}
+
+TEST_F(CliTest, ABadEnvironmentIsAUsageErrorNamingTheVariable) {
+  {
+    ScopedEnvironment listen("LIMN_LISTEN", "nowhere");
+    CliRun run = runLimn("serve");
+    EXPECT_EQ(run.exitCode, 1);
+    EXPECT_NE(run.err.find("LIMN_LISTEN wants HOST:PORT, got nowhere"), std::string::npos)
+        << run.err;
+  }
+  ScopedEnvironment config("LIMN_CONFIG", (dir_ / "missing.json").string());
+  CliRun run = runLimn("serve --listen 127.0.0.1:0");
+  EXPECT_EQ(run.exitCode, 1);
+  EXPECT_NE(run.err.find("missing.json: cannot be opened"), std::string::npos) << run.err;
+}
+
 TEST_F(CliTest, HelpAndVersion) {
   CliRun help = runLimn("--help");
   EXPECT_EQ(help.exitCode, 0);
   EXPECT_NE(help.out.find("limn serve"), std::string::npos);
   EXPECT_NE(help.out.find("limn render"), std::string::npos);
+  EXPECT_NE(help.out.find("LIMN_CONFIG"), std::string::npos);
+  EXPECT_NE(help.out.find("LIMN_LISTEN"), std::string::npos);
   EXPECT_EQ(runLimn("help").out, help.out);
   CliRun version = runLimn("--version");
   EXPECT_EQ(version.exitCode, 0);

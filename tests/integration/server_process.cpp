@@ -25,8 +25,9 @@ namespace limn::testing {
 const char* limnBinary() { return LIMN_BINARY; }
 
 ServerProcess::ServerProcess(const std::vector<std::string>& extraArgs,
-                             std::chrono::seconds startTimeout) {
-  std::vector<std::string> args{limnBinary(), "serve", "--listen", "127.0.0.1:0"};
+                             std::chrono::seconds startTimeout, bool loopbackListen) {
+  std::vector<std::string> args{limnBinary(), "serve"};
+  if (loopbackListen) args.insert(args.end(), {"--listen", "127.0.0.1:0"});
   args.insert(args.end(), extraArgs.begin(), extraArgs.end());
 
   // Everything the child needs is allocated before fork(): only exec-safe calls after it.
@@ -76,6 +77,8 @@ ServerProcess::ServerProcess(const std::vector<std::string>& extraArgs,
   // The server prints nothing else on stdout; its writes would fail quietly (it ignores SIGPIPE).
   ::close(out[0]);
   port_ = std::stoi(match[2].str());
+  host_ = match[1].str();
+  if (host_.size() >= 2 && host_.front() == '[') host_ = host_.substr(1, host_.size() - 2);
 }
 
 ServerProcess ServerProcess::withConfig(const std::string& configJson,
@@ -94,7 +97,10 @@ ServerProcess ServerProcess::withConfig(const std::string& configJson,
 }
 
 ServerProcess::ServerProcess(ServerProcess&& other) noexcept
-    : pid_(other.pid_), port_(other.port_), configPath_(std::move(other.configPath_)) {
+    : pid_(other.pid_),
+      port_(other.port_),
+      host_(std::move(other.host_)),
+      configPath_(std::move(other.configPath_)) {
   other.pid_ = -1;
   other.configPath_.clear();
 }

@@ -17,10 +17,13 @@ const char* limnBinary();
 
 class ServerProcess {
  public:
-  // Runs `limn serve --listen 127.0.0.1:0 <extraArgs...>`; throws std::runtime_error when the
-  // server exits or stays silent for `startTimeout` instead of announcing its port.
+  // Runs `limn serve --listen 127.0.0.1:0 <extraArgs...>` (without `--listen 127.0.0.1:0`
+  // when `loopbackListen` is false: the address then comes from the environment or a
+  // configuration file); throws std::runtime_error when the server exits or stays silent for
+  // `startTimeout` instead of announcing its port.
   explicit ServerProcess(const std::vector<std::string>& extraArgs = {},
-                         std::chrono::seconds startTimeout = std::chrono::seconds(60));
+                         std::chrono::seconds startTimeout = std::chrono::seconds(60),
+                         bool loopbackListen = true);
   // Same, with a configuration file holding `configJson` (--config).
   static ServerProcess withConfig(const std::string& configJson,
                                   const std::vector<std::string>& extraArgs = {});
@@ -30,6 +33,8 @@ class ServerProcess {
   ServerProcess(const ServerProcess&) = delete;
 
   int port() const { return port_; }
+  // The address it announced (brackets removed from an IPv6 one).
+  const std::string& host() const { return host_; }
   pid_t pid() const { return pid_; }
 
   // Sends `signal` and waits for the process to end: its exit status, 128 + the signal when a
@@ -40,6 +45,7 @@ class ServerProcess {
  private:
   pid_t pid_ = -1;
   int port_ = 0;
+  std::string host_;
   std::string configPath_;  // removed with the process
 };
 
