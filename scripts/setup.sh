@@ -1,24 +1,42 @@
 #!/usr/bin/env bash
 # Installs what limn needs to build and run, from Debian 12 packages. Safe to run again: it
 # installs only what is missing. Uses sudo when not root.
+#
+#   scripts/setup.sh                          everything: build, tests, browser tests, quality gates
+#   LIMN_SETUP_PROFILE=build scripts/setup.sh only what compiling limn needs (docker/Dockerfile's
+#                                             build stage: no chromium, node, clang or test tools)
 set -euo pipefail
 
+profile="${LIMN_SETUP_PROFILE:-full}"
+case "$profile" in
+  full | build) ;;
+  *) echo "setup: LIMN_SETUP_PROFILE must be full or build, not $profile" >&2; exit 1 ;;
+esac
+
+# What configuring and compiling every target needs (render/implicit needs muparser). CMake
+# requires GoogleTest even when only the limn executable is built, and OpenImageIO's CMake
+# package refuses to load without its command-line tools (openimageio-tools: it checks that
+# /usr/bin/iconvert exists).
 packages=(
   cmake ninja-build g++ pkg-config
   libembree-dev libosd-dev libopenimageio-dev openimageio-tools libboost-dev rapidjson-dev
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev libmuparser-dev curl
-  # the quality gates: clang with its sanitizer runtimes and libFuzzer (scripts/sanitize.sh,
-  # scripts/fuzz.sh), Prometheus' text-format parser and a JSON Schema validator (the /metrics and
-  # OpenAPI tests), the load generator
-  clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
-  # the implicit-surface benchmark's baseline (bench/implicit_vs_skimage.py)
-  python3-skimage
+  libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev libmuparser-dev
 )
-
-# The browser tests (tests/browser): Debian's chromium, and node + npm unless a node is there.
-packages+=(chromium)
-command -v node >/dev/null || packages+=(nodejs npm)
+if [ "$profile" = full ]; then
+  packages+=(
+    curl
+    # the quality gates: clang with its sanitizer runtimes and libFuzzer (scripts/sanitize.sh,
+    # scripts/fuzz.sh), Prometheus' text-format parser and a JSON Schema validator (the /metrics
+    # and OpenAPI tests), the load generator
+    clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
+    # the implicit-surface benchmark's baseline (bench/implicit_vs_skimage.py)
+    python3-skimage
+  )
+  # The browser tests (tests/browser): Debian's chromium, and node + npm unless a node is there.
+  packages+=(chromium)
+  command -v node >/dev/null || packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -32,6 +50,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   $sudo apt-get update -qq
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
+[ "$profile" = build ] && exit 0
 
 # playwright-core for the browser tests, exactly as tests/browser/package-lock.json pins it,
 # into build/browser-tests (again only when the lockfile changed). A machine where npm cannot
