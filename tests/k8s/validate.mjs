@@ -277,6 +277,31 @@ function checkPod(all, o, errors) {
   }
 }
 
+// The configuration a limn container reads (LIMN_CONFIG, else the image's file): only limn's
+// keys, "workers" set and equal to the CPU, memory for them. Returns it with defaults filled in.
+function checkWorkers(all, pod, c, cw, errors) {
+  const configPath = envOf(c, "LIMN_CONFIG")?.value ?? imageConfig;
+  const found = configMapFile(all, pod, c, configPath, errors, cw);
+  if (!found) return null;
+  const config = found.json;
+  const defaults = JSON.parse(fs.readFileSync(path.join(repoRoot, "configs/default.json"), "utf8"));
+  for (const key of unknownKeys(config, defaults))
+    errors.push(`${cw}: configuration key "${key}" is not one of limn's (configs/default.json)`);
+  const workers = config.workers;
+  if (!Number.isInteger(workers) || workers < 1) {
+    errors.push(`${cw}: the configuration must set "workers" (0 means the node's cores, not the pod's): ${workers}`);
+    return null;
+  }
+  const req = c.resources?.requests ?? {}, lim = c.resources?.limits ?? {};
+  if (cores(req.cpu) !== workers || cores(lim.cpu) !== workers)
+    errors.push(`${cw}: CPU requests and limits (${req.cpu}, ${lim.cpu}) must equal the ${workers} workers`);
+  const cache = config.referenceCacheBytes ?? defaults.referenceCacheBytes;
+  const need = idleBytes + cache + workers * perWorkerBytes;
+  if (!(bytes(lim.memory) >= need))
+    errors.push(`${cw}: memory limit ${lim.memory} is below what ${workers} workers and a ${Math.round(cache / MiB)} MiB reference cache need (${Math.round(need / MiB)} MiB)`);
+  return { ...defaults, ...config };
+}
+
 function checkServer(all, o, errors) {
   const pod = podSpecOf(o.obj);
   for (const c of pod?.containers ?? []) {
@@ -297,26 +322,9 @@ function checkServer(all, o, errors) {
     probe("readinessProbe", "/readyz");
     probe("startupProbe", "/healthz");
 
-    const configPath = envOf(c, "LIMN_CONFIG")?.value ?? imageConfig;
-    const found = configMapFile(all, pod, c, configPath, errors, cw);
-    if (!found) continue;
-    const config = found.json;
-    const defaults = JSON.parse(fs.readFileSync(path.join(repoRoot, "configs/default.json"), "utf8"));
-    for (const key of unknownKeys(config, defaults))
-      errors.push(`${cw}: configuration key "${key}" is not one of limn's (configs/default.json)`);
-    const workers = config.workers;
-    if (!Number.isInteger(workers) || workers < 1) {
-      errors.push(`${cw}: the configuration must set "workers" (0 means the node's cores, not the pod's): ${workers}`);
-      continue;
-    }
-    const req = c.resources?.requests ?? {}, lim = c.resources?.limits ?? {};
-    if (cores(req.cpu) !== workers || cores(lim.cpu) !== workers)
-      errors.push(`${cw}: CPU requests and limits (${req.cpu}, ${lim.cpu}) must equal the ${workers} workers`);
-    const cache = config.referenceCacheBytes ?? defaults.referenceCacheBytes;
-    const need = idleBytes + cache + workers * perWorkerBytes;
-    if (!(bytes(lim.memory) >= need))
-      errors.push(`${cw}: memory limit ${lim.memory} is below what ${workers} workers and a ${Math.round(cache / MiB)} MiB reference cache need (${Math.round(need / MiB)} MiB)`);
-    const drain = (config.shutdownDrainMs ?? defaults.shutdownDrainMs) / 1000;
+    const config = checkWorkers(all, pod, c, cw, errors);
+    if (!config) continue;
+    const drain = config.shutdownDrainMs / 1000;
     const preStop = c.lifecycle?.preStop?.exec?.command;
     const sleep = preStop?.[0] === "sleep" ? Number(preStop[1]) : (c.lifecycle?.preStop?.sleep?.seconds ?? 0);
     const grace = pod.terminationGracePeriodSeconds ?? 30;
@@ -346,6 +354,8 @@ function checkBatch(all, errors) {
     if (pod.restartPolicy !== "Never") errors.push(`${what}: restartPolicy must be Never`);
     for (const c of pod.containers.filter((c) => c.args?.[0] === "batch")) {
       const a = c.args;
+      // A shard renders with `workers` threads too: the node's cores unless configured.
+      checkWorkers(all, pod, c, `${what} container ${c.name}`, errors);
       const count = flagValue(a, "--shard-count");
       if (Number(count) !== spec.completions)
         errors.push(`${what}: --shard-count ${count} must equal completions ${spec.completions}`);
@@ -505,6 +515,10 @@ const breakages = [
   ["a Job that is not Indexed", "completionMode must be Indexed", (t) => { delete shardJob(t).spec.completionMode; }],
   ["shards writing off the volume", "--out /tmp/results is not a mounted", (t) => { const a = podSpecOf(shardJob(t)).containers[0].args; a[a.indexOf("--out") + 1] = "/tmp/results"; }],
   ["a merge step on another volume", "is not the shards' volume", (t) => { podSpecOf(find(t, "Job", "limn-batch-report")).containers[0].volumeMounts[0].mountPath = "/other"; }],
+  ["a shard with more workers than cores", "(2, 2) must equal the 3 workers", (t) => {
+    const cm = find(t, "ConfigMap", "limn-batch-spec");
+    cm.data["limn.json"] = JSON.stringify({ ...JSON.parse(cm.data["limn.json"]), workers: 3 });
+  }],
   ["a volume naming a missing ConfigMap", "names ConfigMap limn-batch-spek", (t) => { podSpecOf(shardJob(t)).volumes.find((v) => v.configMap).configMap.name = "limn-batch-spek"; }],
   ["a manifest no kustomization lists", "listed in no kustomization.yaml", (t) => { top(t).obj.resources.pop(); }],
   ["a kustomization naming a missing file", "resource hpa.yml is not a manifest", (t) => { top(t).obj.resources.push("hpa.yml"); }],
