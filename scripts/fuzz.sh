@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift $(( $# > 0 ? 1 : 0 ))
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(obj_reader json_mesh render_request silhouette_request config)
+[ ${#targets[@]} -eq 0 ] && targets=(obj_reader json_mesh render_request silhouette_request implicit_request config)
 [ -x build-sanitize/bin/obj_reader_fuzz ] || scripts/sanitize.sh -N >/dev/null
 mkdir -p build-sanitize/fuzz-findings build-sanitize/fuzz-logs
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
