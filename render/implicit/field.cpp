@@ -515,6 +515,33 @@ Vec3 FieldEvaluator::normal(const Vec3& p) {
   return n > 0 ? g * (-1.0 / n) : Vec3{0, 0, 0};
 }
 
+double rootOnSegment(FieldEvaluator& field, const Vec3& origin, const Vec3& direction, double t0,
+                     double f0, double t1, double f1, double tolerance) {
+  if (f0 == 0) return t0;
+  if (f1 == 0) return t1;
+  int side = 0;
+  double t = t0;
+  for (int i = 0; i < 60 && (t1 - t0) > tolerance; ++i) {
+    t = (t0 * f1 - t1 * f0) / (f1 - f0);
+    if (!(t > t0 && t < t1)) t = 0.5 * (t0 + t1);
+    const double ft = field.value(origin + direction * t);
+    if (ft == 0) return t;
+    // Illinois: halve the value of the end that stays, so that it does not stay forever.
+    if ((ft > 0) == (f0 > 0)) {
+      t0 = t;
+      f0 = ft;
+      if (side == -1) f1 *= 0.5;
+      side = -1;
+    } else {
+      t1 = t;
+      f1 = ft;
+      if (side == 1) f0 *= 0.5;
+      side = 1;
+    }
+  }
+  return t;
+}
+
 bool projectToSurface(FieldEvaluator& field, Vec3& p, double tolerance, double maxStep,
                       int maxSteps) {
   for (int i = 0; i < maxSteps; ++i) {

@@ -131,6 +131,12 @@ class FieldEvaluator {
   std::unique_ptr<ExpressionSet> expressions_;  // this thread's copy
 };
 
+// The root of F - iso on origin + t direction for t in [t0, t1], bracketed by f0 and f1 (F - iso
+// at the ends, of opposite signs): Illinois regula falsi until the bracket is shorter than
+// `tolerance` (in t) or 60 steps are done.
+double rootOnSegment(FieldEvaluator& field, const Vec3& origin, const Vec3& direction, double t0,
+                     double f0, double t1, double f1, double tolerance);
+
 // Moves p onto the surface along the gradient (Newton steps), until |F - iso| / |grad F| is below
 // `tolerance` (world units) or `maxSteps` are done; the steps are clamped to `maxStep` so a point
 // never jumps to another sheet. Returns whether it converged.

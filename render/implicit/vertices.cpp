@@ -11,33 +11,11 @@ namespace limn::render::implicit {
 
 namespace {
 
-// Illinois regula falsi for the root of F - iso on a-b, bracketed by fa and fb of opposite signs.
+// The vertex on a-b: the field's root between the two samples of opposite signs.
 Vec3 rootOnEdge(FieldEvaluator& field, const EdgeVertex& e, double tolerance) {
   const Vec3 d = e.b - e.a;
-  const double len = length(d);
-  double t0 = 0, t1 = 1, f0 = e.fa, f1 = e.fb;
-  if (f0 == 0) return e.a;
-  if (f1 == 0) return e.b;
-  double t = f0 / (f0 - f1);
-  int side = 0;
-  for (int i = 0; i < 40; ++i) {
-    t = (t0 * f1 - t1 * f0) / (f1 - f0);
-    const double f = field.value(e.a + d * t);
-    if (f == 0) break;
-    if ((f > 0) == (f0 > 0)) {
-      t0 = t;
-      f0 = f;
-      if (side == -1) f1 *= 0.5;
-      side = -1;
-    } else {
-      t1 = t;
-      f1 = f;
-      if (side == 1) f0 *= 0.5;
-      side = 1;
-    }
-    if ((t1 - t0) * len < tolerance) break;
-  }
-  return e.a + d * t;
+  const double len = std::max(length(d), 1e-300);
+  return e.a + d * rootOnSegment(field, e.a, d, 0.0, e.fa, 1.0, e.fb, tolerance / len);
 }
 
 uint64_t edgeKey(uint32_t a, uint32_t b) { return (static_cast<uint64_t>(a) << 32) | b; }

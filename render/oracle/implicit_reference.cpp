@@ -40,31 +40,6 @@ struct IsosurfaceScene {
       : field(&f), evaluators([&f] { return implicit::FieldEvaluator(f); }) {}
 };
 
-// Illinois regula falsi on a bracket [t0, t1] of F - iso along o + t d.
-double refineBracket(implicit::FieldEvaluator& f, const Vec3& o, const Vec3& d, double t0,
-                     double f0, double t1, double f1, double tolerance) {
-  int side = 0;
-  double t = t0;
-  for (int i = 0; i < 60 && (t1 - t0) > tolerance; ++i) {
-    t = (t0 * f1 - t1 * f0) / (f1 - f0);
-    if (!(t > t0 && t < t1)) t = 0.5 * (t0 + t1);
-    const double ft = f.value(o + d * t);
-    if (ft == 0) return t;
-    if ((ft > 0) == (f0 > 0)) {
-      t0 = t;
-      f0 = ft;
-      if (side == -1) f1 *= 0.5;
-      side = -1;
-    } else {
-      t1 = t;
-      f1 = ft;
-      if (side == 1) f0 *= 0.5;
-      side = 1;
-    }
-  }
-  return t;
-}
-
 // The first t in [t0, t1] where F - iso changes sign along o + t d (|d| = 1), or -1; `refine`
 // false stops at the bracket (an occlusion ray only needs to know there is one). When the
 // stretch starts inside (F > iso) after the ray's own start, an earlier box holds the crossing
@@ -84,7 +59,7 @@ double firstCrossing(IsosurfaceScene& scene, implicit::FieldEvaluator& f, const 
     const double tn = std::min(t + step, t1);
     const double fn = f.value(o + d * tn);
     if ((fn > 0) != inside) {
-      return refine ? refineBracket(f, o, d, t, ft, tn, fn, scene.tolerance) : tn;
+      return refine ? implicit::rootOnSegment(f, o, d, t, ft, tn, fn, scene.tolerance) : tn;
     }
     if (tn >= t1) return -1;
     t = tn;
@@ -239,7 +214,7 @@ SurfaceHit exactHit(implicit::FieldEvaluator& f, const Camera& camera, int x, in
   SurfaceHit hit;
   hit.t = t;
   if ((f0 > 0) != (f1 > 0)) {
-    hit.t = refineBracket(f, o, d, t0, f0, t1, f1, tolerance);
+    hit.t = implicit::rootOnSegment(f, o, d, t0, f0, t1, f1, tolerance);
     hit.refined = true;
   }
   hit.position = o + d * hit.t;
