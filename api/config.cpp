@@ -124,6 +124,7 @@ void readLimits(const Value& object, const std::string& source,
   r.integer("maxPrimitives", limits.maxPrimitives, 1);
   r.integer("maxResolution", limits.maxResolution, 2);
   r.size("maxExpressionLength", limits.maxExpressionLength, 1);
+  r.size("maxCompareRows", limits.maxCompareRows, 1);
   r.finish();
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "api/implicit_api.h"
+#include "api/compare_api.h"
 #include "api/openapi.h"
 #include "api/silhouette_api.h"
 #include "server/web_assets.h"
@@ -29,6 +30,7 @@ constexpr Route kRoutes[] = {
     {"/healthz", "GET"},      {"/readyz", "GET"},         {"/metrics", "GET"},
     {"/openapi.json", "GET"}, {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
     {"/v1/meshes", "POST"},   {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
+    {"/v1/compare", "POST"},
 };
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
@@ -161,6 +163,7 @@ WorkerPool::Abandon Router::route(Request request, Reply reply) {
     return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
   }
   if (path == "/v1/meshes") return uploadMesh(std::move(request.body), std::move(reply));
+  if (path == "/v1/compare") return compare(std::move(request.body), std::move(reply));
   if (path == "/v1/tessellate") {
     return tessellate(std::move(request.body), std::move(request.accept), std::move(reply));
   }
@@ -222,6 +225,17 @@ WorkerPool::Abandon Router::implicit(std::string body, std::string accept, Reply
       [body = std::move(body), accept = std::move(accept), limits = limits_](
           render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
         return api::handleImplicit(body, accept, limits, context, cancel);
+      },
+      std::move(reply));
+}
+
+// Several methods against one reference per camera: one job on one worker (the request's
+// deadline covers all of its rows).
+WorkerPool::Abandon Router::compare(std::string body, Reply reply) {
+  return pool_.submit(
+      [body = std::move(body), limits = limits_, meshes = meshes_](
+          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
+        return api::handleCompare(body, limits, context, cancel, meshes);
       },
       std::move(reply));
 }

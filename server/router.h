@@ -14,6 +14,7 @@
 //   POST /v1/meshes     api::handleMeshUpload on a worker thread, into the MeshCache
 //   POST /v1/tessellate api::handleTessellate on a worker thread (the mesh, no raster)
 //   POST /v1/implicit   api::handleImplicit on a worker thread (an implicit field's scene)
+//   POST /v1/compare    api::handleCompare on a worker thread (methods x cameras, one job)
 //   GET  /, /NAME.js, /examples, /examples/NAME   the built-in page and examples (web_assets.h)
 #pragma once
 
@@ -73,6 +74,7 @@ class Router {
   WorkerPool::Abandon uploadMesh(std::string body, Reply reply);
   WorkerPool::Abandon tessellate(std::string body, std::string accept, Reply reply);
   WorkerPool::Abandon implicit(std::string body, std::string accept, Reply reply);
+  WorkerPool::Abandon compare(std::string body, Reply reply);
   api::Answer webAsset(const EmbeddedFile& file) const;
 
   WorkerPool::Abandon route(Request request, Reply reply);
