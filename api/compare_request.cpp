@@ -106,6 +106,12 @@ ParsedMethod parseCompareMethod(const Value& entry, const std::string& field,
       if (label.empty()) json::fail(field + ".label", field + ".label must not be empty");
     }
   }
+  if (method.method == Method::Limit) {
+    json::fail(field + ".method",
+               field +
+                   ".method \"limit\" is the reference every row is measured against; list the "
+                   "methods to compare with it");
+  }
   if (method.method != Method::Uniform &&
       (method.params.engine != render::pipeline::Engine::OpenSubdiv || method.params.pushToLimit)) {
     warnings.push_back(field +
