@@ -267,10 +267,10 @@ void writeImages(Writer& w, const render::ImageSet& images, const Outputs& outpu
                  render::image::Format format, const char* owner,
                  std::vector<std::string>& warnings) {
   const std::vector<std::string> none;
-  api::writeImages(w, images,
-                   AnswerShape{.outputs = outputs, .reference = false, .imageFormat = format,
-                               .warnings = none},
-                   owner, warnings);
+  api::writeImages(
+      w, images,
+      AnswerShape{.outputs = outputs, .reference = false, .imageFormat = format, .warnings = none},
+      owner, warnings);
 }
 
 void writeMetrics(Writer& w, const render::metrics::Metrics& metrics) {

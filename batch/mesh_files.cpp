@@ -24,8 +24,10 @@ std::string readText(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// The files one pattern stands for, sorted by name.
-std::vector<fs::path> filesOf(const std::string& pattern, const fs::path& base) {
+// The files one pattern stands for, sorted by name. A glob may match nothing (a corpus this
+// machine does not have: a warning); a file or folder that is not there is an error.
+std::vector<fs::path> filesOf(const std::string& pattern, const fs::path& base,
+                              std::vector<std::string>& warnings) {
   fs::path full = fs::path(pattern).is_absolute() ? fs::path(pattern) : base / pattern;
   std::vector<fs::path> files;
   if (isGlob(pattern)) {
@@ -45,7 +47,11 @@ std::vector<fs::path> filesOf(const std::string& pattern, const fs::path& base) 
   } else if (fs::is_regular_file(full)) {
     files.push_back(full);
   }
-  if (files.empty()) throw MeshFileError("meshes: no mesh file matches " + pattern);
+  if (files.empty() && isGlob(pattern)) {
+    warnings.push_back("no mesh file matches " + pattern + "; left out");
+  } else if (files.empty()) {
+    throw MeshFileError("meshes: no mesh file matches " + pattern);
+  }
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -101,7 +107,7 @@ std::vector<api::BatchMesh> loadMeshes(const std::vector<api::MeshEntry>& entrie
       }
       continue;
     }
-    for (const fs::path& file : filesOf(entry.pattern, base)) {
+    for (const fs::path& file : filesOf(entry.pattern, base, warnings)) {
       const std::string scheme = entry.scheme.value_or(guessScheme(file));
       // As the spec wrote it: relative patterns give paths relative to `base`.
       const fs::path shown = fs::path(entry.pattern).is_absolute()
@@ -115,6 +121,7 @@ std::vector<api::BatchMesh> loadMeshes(const std::vector<api::MeshEntry>& entrie
       }
     }
   }
+  if (meshes.empty()) throw MeshFileError("meshes: the spec names no mesh that is there");
   nameMeshes(meshes);
   return meshes;
 }

@@ -24,8 +24,10 @@ class MeshFileError : public std::runtime_error {
 };
 
 // Relative patterns are taken from `base` (the spec file's folder, or the current one for
-// --meshes). A mesh found twice (the same content hash) is kept once, with a warning; meshes
-// whose file names collide are named "folder/stem" instead of "stem".
+// --meshes). A glob that matches nothing is left out with a warning (an optional corpus); a
+// file or folder that is not there, or no mesh at all, throws MeshFileError. A mesh found twice
+// (the same content hash) is kept once, with a warning; meshes whose file names collide are named
+// "folder/stem" instead of "stem".
 std::vector<api::BatchMesh> loadMeshes(const std::vector<api::MeshEntry>& entries,
                                        const std::filesystem::path& base,
                                        const render::pipeline::JobLimits& limits,

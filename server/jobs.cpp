@@ -95,7 +95,7 @@ api::Answer JobManager::create(std::string_view body) {
 
 api::Answer JobManager::get(const std::string& id, size_t offset) {
   std::lock_guard lock(mutex_);
-  makeRoomLocked();  // drops what is past its retention
+  dropExpiredLocked();
   auto it = jobs_.find(id);
   return it == jobs_.end() ? notFound(id) : viewLocked(*it->second, offset, 200);
 }
@@ -107,7 +107,7 @@ api::Answer JobManager::cancel(const std::string& id) {
   std::shared_ptr<Job> job = it->second;
   if (job->done()) {
     jobs_.erase(it);
-    return viewLocked(*job, job->rows.size(), 200);
+    return viewLocked(*job, 0, 200);
   }
   job->cancelled = true;
   if (job->state == "queued") {
@@ -117,14 +117,18 @@ api::Answer JobManager::cancel(const std::string& id) {
   }
   // A running job stops within a moment (its comparisons in flight are given up).
   changed_.wait_for(lock, std::chrono::seconds(10), [&] { return job->done(); });
-  return viewLocked(*job, job->rows.size(), 200);
+  return viewLocked(*job, 0, 200);
 }
 
-bool JobManager::makeRoomLocked() {
+void JobManager::dropExpiredLocked() {
   const Clock::time_point now = Clock::now();
   std::erase_if(jobs_, [&](const auto& entry) {
     return entry.second->done() && now - entry.second->finished > options_.retention;
   });
+}
+
+bool JobManager::makeRoomLocked() {
+  dropExpiredLocked();
   while (jobs_.size() >= options_.maxJobs) {
     auto oldest = jobs_.end();
     for (auto it = jobs_.begin(); it != jobs_.end(); ++it) {

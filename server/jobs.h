@@ -57,8 +57,10 @@ class JobManager {
   struct Job;
   void driverLoop();
   void runJob(Job& job);
-  // Drops finished jobs past their retention, then, while the table is full, the oldest
-  // finished one; false when it stays full (every job unfinished).
+  // Drops the finished jobs past their retention.
+  void dropExpiredLocked();
+  // For a new job: dropExpiredLocked(), then, while the table is full, the oldest finished
+  // job; false when it stays full (every job unfinished).
   bool makeRoomLocked();
   api::Answer viewLocked(const Job& job, size_t offset, int status) const;
 

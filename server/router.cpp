@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "api/implicit_api.h"
 #include "api/compare_api.h"
+#include "api/implicit_api.h"
 #include "api/openapi.h"
 #include "api/silhouette_api.h"
 #include "server/web_assets.h"
@@ -27,10 +27,10 @@ struct Route {
 
 // Every (path, method) limn answers; a known path with another method is a 405 listing these.
 constexpr Route kRoutes[] = {
-    {"/healthz", "GET"},      {"/readyz", "GET"},         {"/metrics", "GET"},
-    {"/openapi.json", "GET"}, {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
-    {"/v1/meshes", "POST"},   {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
-    {"/v1/compare", "POST"},  {"/v1/jobs", "POST"},     {"/v1/jobs/{id}", "GET"},
+    {"/healthz", "GET"},         {"/readyz", "GET"},         {"/metrics", "GET"},
+    {"/openapi.json", "GET"},    {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
+    {"/v1/meshes", "POST"},      {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
+    {"/v1/compare", "POST"},     {"/v1/jobs", "POST"},       {"/v1/jobs/{id}", "GET"},
     {"/v1/jobs/{id}", "DELETE"},
 };
 

@@ -87,9 +87,8 @@ void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
 // The supersampled mask, S x S rays only in the pixels that need them (result.refinedPixels).
 // The hint is a mask (one method's) or its blocks (several methods' merged).
 void castSupersampledMask(const ReferenceScene& built, RTCScene scene, const Camera& camera,
-                          const std::vector<PixelHit>& hits, int s,
-                          const ReferenceOptions& options, const CancelToken& cancel,
-                          ReferenceResult& result) {
+                          const std::vector<PixelHit>& hits, int s, const ReferenceOptions& options,
+                          const CancelToken& cancel, ReferenceResult& result) {
   const int width = camera.width(), height = camera.height();
   std::vector<char> coverage(hits.size());
   for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();

@@ -8,12 +8,12 @@ namespace limn::render::pipeline {
 
 metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet& images,
                                const Camera& camera, int S,
-                               const oracle::ReferenceResult& reference, double diagonal,
-                               bool diff, const CancelToken& cancel) {
+                               const oracle::ReferenceResult& reference, double diagonal, bool diff,
+                               const CancelToken& cancel) {
   const ImageSet& refImages = reference.images;
   metrics::Metrics m;
-  m.silhouette = metrics::compareSilhouettes(images.supersampledMask, refImages.supersampledMask,
-                                             S, cancel);
+  m.silhouette =
+      metrics::compareSilhouettes(images.supersampledMask, refImages.supersampledMask, S, cancel);
   // The reference was hinted with this mask: its refined pixels hold all of its outline.
   metrics::Outline outline = oracle::locateMeshOutline(approx, camera, images.supersampledMask, S,
                                                        cancel, &reference.refinedPixels);

@@ -17,8 +17,8 @@ namespace limn::render::pipeline {
 // `diagonal`) and normal metrics; with `diff`, the heat map goes into `images`.
 metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet& images,
                                const Camera& camera, int S,
-                               const oracle::ReferenceResult& reference, double diagonal,
-                               bool diff, const CancelToken& cancel);
+                               const oracle::ReferenceResult& reference, double diagonal, bool diff,
+                               const CancelToken& cancel);
 
 // The same into result.metrics, for result.images.
 void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camera& camera, int S,

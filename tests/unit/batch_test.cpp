@@ -379,7 +379,16 @@ TEST_F(ResultsFolder, MeshFilesFoldersAndGlobsResolveInNameOrderWithTheirSchemes
   EXPECT_EQ(meshes[0].path, "shapes/b_cube.obj");
   EXPECT_EQ(batch::guessScheme(dir_ / "shapes/loop_tetra.obj"), "loop");
   EXPECT_EQ(warnings.size(), 1u);
+  // A glob that matches nothing is an optional corpus; a missing file is a mistake.
+  warnings.clear();
+  EXPECT_EQ(batch::loadMeshes({{"a_cube.obj", {}, "", ""}, {"corpus/*.obj", {}, "", ""}}, dir_,
+                              kLimits, warnings)
+                .size(),
+            1u);
+  EXPECT_EQ(warnings.size(), 1u);
   EXPECT_THROW(batch::loadMeshes({{"nothing*.obj", {}, "", ""}}, dir_, kLimits, warnings),
+               batch::MeshFileError);
+  EXPECT_THROW(batch::loadMeshes({{"missing.obj", {}, "", ""}}, dir_, kLimits, warnings),
                batch::MeshFileError);
 }
 
