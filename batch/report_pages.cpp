@@ -55,8 +55,9 @@ const char* kExplanation =
     "Error: the outline Hausdorff distance between the method's outline and the exact limit "
     "surface's, in output pixels (`metrics.silhouette.outlineHausdorffPx`); p95 is the nearest "
     "rank. IoU: of the two coverage masks. Geometry: the largest distance to the limit surface "
-    "relative to the bounding-box diagonal. ms: the method's own time (approximation + raster), "
-    "median; the reference (built once per mesh and view) and the metrics are not in it.";
+    "relative to the bounding-box diagonal. ms: the method's own time, median: its approximation "
+    "and the raster of the passes its metrics need (colour, mask, depth and normal, the mask at S "
+    "times the size); the reference (built once per mesh and view) and the metrics are not in it.";
 
 struct Table {
   std::vector<std::string> header;
@@ -108,6 +109,12 @@ Table failedRows(const std::vector<api::ResultRow>& rows) {
   return t;
 }
 
+bool isNumber(const std::string& text) {
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size();
+}
+
 std::string markdown(const Table& t) {
   auto cell = [](std::string text) {
     for (size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2)) {
@@ -118,7 +125,11 @@ std::string markdown(const Table& t) {
   std::string out = "|";
   for (const std::string& h : t.header) out += " " + h + " |";
   out += "\n|";
-  for (size_t i = 0; i < t.header.size(); ++i) out += i == 0 ? " --- |" : " ---: |";
+  // Numbers right-aligned, words left: judged by the first row.
+  for (size_t i = 0; i < t.header.size(); ++i) {
+    const bool numeric = !t.rows.empty() && isNumber(t.rows.front()[i]);
+    out += numeric ? " ---: |" : " --- |";
+  }
   out += "\n";
   for (const auto& row : t.rows) {
     out += "|";

@@ -2,7 +2,7 @@
 """One POST /v1/compare against the same rows as separate POST /v1/render calls.
 
 Usage: compare_vs_render.py URL MESH.obj[,MESH.obj...] [--size 1024] [--views 3]
-       [--methods coarse,uniform:3,adaptive:1,silhouette]
+       [--methods coarse,uniform:3,adaptive:1,silhouette] [--seed-azimuth DEG]
 
 For each mesh: the views are orbit views (azimuth 0, 120, 240 at elevation 20, then more round
 the ring); every method of every view is rendered alone with "reference": true, one request at
@@ -45,7 +45,8 @@ def largest_difference(a, b):
 
 def main():
     args = sys.argv[1:]
-    options = {"--size": "1024", "--views": "3", "--methods": "coarse,uniform:3,adaptive:1,silhouette"}
+    options = {"--size": "1024", "--views": "3", "--methods": "coarse,uniform:3,adaptive:1,silhouette",
+               "--seed-azimuth": "0"}
     positional = []
     while args:
         a = args.pop(0)
@@ -56,7 +57,10 @@ def main():
     url, meshes = positional[0].rstrip("/"), positional[1].split(",")
     size, views = int(options["--size"]), int(options["--views"])
     methods = [method_entry(m) for m in options["--methods"].split(",")]
-    cameras = [{"orbit": {"azimuthDeg": 360.0 * i / views, "elevationDeg": 20}, "width": size,
+    # --seed-azimuth moves the ring, so that a second run on the same server meets views its
+    # reference cache has not seen.
+    start = float(options["--seed-azimuth"])
+    cameras = [{"orbit": {"azimuthDeg": start + 360.0 * i / views, "elevationDeg": 20}, "width": size,
                 "height": size} for i in range(views)]
     print("| mesh | rows | separate renders s | their referenceMs (sum) | one compare s | its referenceMs (sum) | rows ms (sum) | speed-up | largest metric difference |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
