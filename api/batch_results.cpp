@@ -203,19 +203,21 @@ std::optional<ResultRow> readResultLine(std::string_view line) {
     row.controlFaces = numberOr(d["stats"], "controlFaces", 0);
   }
   if (d.HasMember("metrics") && d["metrics"].IsObject()) {
-    for (auto group = d["metrics"].MemberBegin(); group != d["metrics"].MemberEnd(); ++group) {
-      if (!group->value.IsObject()) continue;
-      for (auto m = group->value.MemberBegin(); m != group->value.MemberEnd(); ++m) {
-        if (m->value.IsNumber()) {
-          row.metrics[std::string(group->name.GetString()) + "." + m->name.GetString()] =
-              m->value.GetDouble();
+    const Value& metrics = d["metrics"];
+    for (const auto& group : metrics.GetObject()) {
+      if (!group.value.IsObject()) continue;
+      for (const auto& m : group.value.GetObject()) {
+        if (m.value.IsNumber()) {
+          row.metrics[std::string(group.name.GetString()) + "." + m.name.GetString()] =
+              m.value.GetDouble();
         }
       }
     }
   }
   if (d.HasMember("timings") && d["timings"].IsObject()) {
-    for (auto t = d["timings"].MemberBegin(); t != d["timings"].MemberEnd(); ++t) {
-      if (t->value.IsNumber()) row.timings[t->name.GetString()] = t->value.GetDouble();
+    const Value& timings = d["timings"];
+    for (const auto& t : timings.GetObject()) {
+      if (t.value.IsNumber()) row.timings[t.name.GetString()] = t.value.GetDouble();
     }
   }
   if (d.HasMember("reference") && d["reference"].IsObject()) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <set>
+#include <utility>
 
 #include "api/batch_views.h"
 #include "api/compare_api.h"
@@ -254,8 +255,8 @@ BatchSpec parseBatchSpec(std::string_view text, const JobLimits& limits) {
   rapidjson::Document root;
   request::parseJson(text, root);
   if (!root.IsObject()) json::fail("", "a batch spec must be a JSON object");
-  for (auto it = root.MemberBegin(); it != root.MemberEnd(); ++it) {
-    std::string_view name(it->name.GetString(), it->name.GetStringLength());
+  for (const auto& member : std::as_const(root).GetObject()) {
+    std::string_view name(member.name.GetString(), member.name.GetStringLength());
     if (name != "meshes" && name != "methods" && name != "cameras" && name != "size" &&
         name != "supersample") {
       json::fail(std::string(name), "the batch spec has no field " + json::quote(name) +

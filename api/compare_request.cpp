@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <map>
+#include <utility>
 
 #include "api/compare_api.h"
 #include "api/json_util.h"
@@ -242,9 +243,9 @@ std::string methodLabel(Method method, const render::pipeline::MethodParams& par
   document.Parse(paramsJson.data(), paramsJson.size());
   std::map<std::string, std::string> others;  // sorted by key
   if (!document.HasParseError() && document.IsObject()) {
-    for (auto it = document.MemberBegin(); it != document.MemberEnd(); ++it) {
-      std::string key(it->name.GetString(), it->name.GetStringLength());
-      if (!main || key != main) others[key] = labelValue(it->value);
+    for (const auto& member : std::as_const(document).GetObject()) {
+      std::string key(member.name.GetString(), member.name.GetStringLength());
+      if (!main || key != main) others[key] = labelValue(member.value);
     }
   }
   for (const auto& [key, value] : others) label += " " + key + "=" + value;

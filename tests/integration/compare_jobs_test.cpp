@@ -158,12 +158,13 @@ TEST_F(CompareServer, BuildsTheReferenceOncePerCameraAndEveryRowEqualsItsOwnRend
     rapidjson::Document a = parse(alone.body);
     const std::string what = method + " camera " + std::to_string(c);
     EXPECT_EQ(a["stats"]["triangles"].GetInt64(), row["stats"]["triangles"].GetInt64()) << what;
-    for (auto group = a["metrics"].MemberBegin(); group != a["metrics"].MemberEnd(); ++group) {
-      const auto& mine = row["metrics"][group->name.GetString()];
-      for (auto m = group->value.MemberBegin(); m != group->value.MemberEnd(); ++m) {
-        const double expected = m->value.GetDouble(), got = mine[m->name.GetString()].GetDouble();
+    const rapidjson::Value& metrics = a["metrics"];
+    for (const auto& group : metrics.GetObject()) {
+      const auto& mine = row["metrics"][group.name.GetString()];
+      for (const auto& m : group.value.GetObject()) {
+        const double expected = m.value.GetDouble(), got = mine[m.name.GetString()].GetDouble();
         EXPECT_NEAR(got, expected, 1e-9 * std::max(1.0, std::fabs(expected)))
-            << what << " " << group->name.GetString() << "." << m->name.GetString();
+            << what << " " << group.name.GetString() << "." << m.name.GetString();
       }
     }
   }
