@@ -106,8 +106,8 @@ class ConfigReader {
   std::vector<std::string> pending_;
 };
 
-void readLimits(const Value& object, const std::string& source,
-                render::pipeline::JobLimits& limits) {
+void readLimits(const Value& object, const std::string& source, ServiceConfig& config) {
+  render::pipeline::JobLimits& limits = config.limits;
   ConfigReader r(object, source, "limits");
   r.integer("maxVertices", limits.mesh.maxVertices, 1);
   r.integer("maxFaces", limits.mesh.maxFaces, 1);
@@ -124,6 +124,9 @@ void readLimits(const Value& object, const std::string& source,
   r.integer("maxPrimitives", limits.maxPrimitives, 1);
   r.integer("maxResolution", limits.maxResolution, 2);
   r.size("maxExpressionLength", limits.maxExpressionLength, 1);
+  r.size("maxCompareRows", limits.maxCompareRows, 1);
+  r.size("maxJobs", config.maxJobs, 1);
+  r.size("maxJobRows", config.maxJobRows, 1);
   r.finish();
 }
 
@@ -156,7 +159,8 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
       config.logLevel != "error" && config.logLevel != "off") {
     throw ConfigError(source + ": \"logLevel\" must be debug, info, warn, error or off");
   }
-  if (const Value* limits = r.object("limits")) readLimits(*limits, source, config.limits);
+  r.integer("jobRetentionSeconds", config.jobRetentionSeconds, 0);
+  if (const Value* limits = r.object("limits")) readLimits(*limits, source, config);
   r.finish();
   return config;
 }

@@ -37,6 +37,11 @@ struct ServiceConfig {
   // The request log's level on stderr: "debug", "info", "warn", "error" or "off".
   std::string logLevel = "info";
   render::pipeline::JobLimits limits;
+  // POST /v1/jobs: jobs held (queued, running or finished; in the file under "limits"), rows of
+  // one job (also under "limits"), and how long a finished job's rows are kept.
+  size_t maxJobs = 8;
+  size_t maxJobRows = 20000;
+  int jobRetentionSeconds = 3600;
 };
 
 // A configuration file that cannot be used; the message names the file and the key.

@@ -1,8 +1,12 @@
 #include "api/json_util.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <vector>
 
 namespace limn::api::json {
 
@@ -135,6 +139,75 @@ void writeNumber(Writer& writer, double value) {
 }
 
 void writeKey(Writer& writer, const char* key) { writer.Key(key); }
+
+namespace {
+
+bool identifierChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+}  // namespace
+
+std::string renameField(std::string text, const std::string& from, const std::string& to) {
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+    const size_t end = at + from.size();
+    const bool whole = (at == 0 || !identifierChar(text[at - 1])) &&
+                       (end == text.size() || !identifierChar(text[end]));
+    if (!whole) {
+      at = end;
+      continue;
+    }
+    text.replace(at, from.size(), to);
+    at += to.size();
+  }
+  return text;
+}
+
+void renameField(ApiError& error, const std::string& from, const std::string& to) {
+  error.message = renameField(std::move(error.message), from, to);
+  error.detailJson = renameField(std::move(error.detailJson), from, to);
+}
+
+namespace {
+
+void writeCanonical(Writer& w, const Value& value) {
+  if (value.IsObject()) {
+    std::vector<const Value::Member*> members;
+    for (auto it = value.MemberBegin(); it != value.MemberEnd(); ++it) members.push_back(&*it);
+    std::sort(members.begin(), members.end(), [](const Value::Member* a, const Value::Member* b) {
+      return std::string_view(a->name.GetString(), a->name.GetStringLength()) <
+             std::string_view(b->name.GetString(), b->name.GetStringLength());
+    });
+    w.StartObject();
+    for (const Value::Member* m : members) {
+      w.Key(m->name.GetString(), m->name.GetStringLength());
+      writeCanonical(w, m->value);
+    }
+    w.EndObject();
+  } else if (value.IsArray()) {
+    w.StartArray();
+    for (const Value& item : value.GetArray()) writeCanonical(w, item);
+    w.EndArray();
+  } else if (value.IsNumber()) {
+    // 1 and 1.0 are the same value: an integral number is written as an integer.
+    const double d = value.GetDouble();
+    constexpr double kExactIntegers = 9007199254740992.0;  // 2^53
+    if (d == std::floor(d) && std::fabs(d) < kExactIntegers) {
+      w.Int64(static_cast<int64_t>(d));
+    } else {
+      writeNumber(w, d);
+    }
+  } else {
+    value.Accept(w);
+  }
+}
+
+}  // namespace
+
+std::string canonical(const Value& value) {
+  rapidjson::StringBuffer buffer;
+  Writer writer(buffer);
+  writeCanonical(writer, value);
+  return {buffer.GetString(), buffer.GetSize()};
+}
 
 void writeString(Writer& writer, std::string_view text) {
   writer.String(text.data(), static_cast<rapidjson::SizeType>(text.size()));

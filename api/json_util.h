@@ -63,6 +63,16 @@ E choice(const Value& value, const std::string& field,
   fail(field, field + " must be one of " + valid + "; got " + quote(got));
 }
 
+// `text` with every `from` that stands as a whole name (not inside a longer one: the "camera"
+// of "cameras") replaced by `to`: re-labels an error's message and detail with the place the
+// value came from ("camera.width" -> "cameras[2].width").
+std::string renameField(std::string text, const std::string& from, const std::string& to);
+void renameField(ApiError& error, const std::string& from, const std::string& to);
+
+// `value` as compact JSON with object keys sorted and integral numbers written as integers:
+// equal values give equal text, so the text can serve as a key.
+std::string canonical(const Value& value);
+
 // A number, or null when it is not finite (JSON has no NaN or infinity).
 void writeNumber(Writer& writer, double value);
 void writeKey(Writer& writer, const char* key);

@@ -263,6 +263,27 @@ namespace response {
 
 void writeCamera(Writer& w, const render::Camera& camera) { api::writeCamera(w, camera); }
 
+void writeImages(Writer& w, const render::ImageSet& images, const Outputs& outputs,
+                 render::image::Format format, const char* owner,
+                 std::vector<std::string>& warnings) {
+  const std::vector<std::string> none;
+  api::writeImages(
+      w, images,
+      AnswerShape{.outputs = outputs, .reference = false, .imageFormat = format, .warnings = none},
+      owner, warnings);
+}
+
+void writeMetrics(Writer& w, const render::metrics::Metrics& metrics) {
+  api::writeMetrics(w, metrics);
+}
+
+void writeStats(Writer& w, const render::pipeline::Stats& stats) { api::writeStats(w, stats); }
+
+void writeReferenceStages(Writer& w, const render::oracle::ReferenceStats& stats,
+                          double crossCheckMs) {
+  api::writeReferenceStages(w, stats, crossCheckMs);
+}
+
 void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& stats,
                           bool presubdivided) {
   api::writeSilhouetteStats(w, stats, presubdivided);

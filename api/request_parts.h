@@ -1,7 +1,7 @@
-// The parts of a request body that several endpoints share (POST /v1/render and
-// POST /v1/silhouette): the JSON document itself, the mesh, the camera, the silhouette
-// method's params and the notes about unknown fields. Defined in render_request.cpp, where
-// /v1/render's reader uses them; every reader throws ApiError (400 invalid_json or
+// The parts of a request body that several endpoints share (POST /v1/render, /v1/silhouette
+// and /v1/compare): the JSON document itself, the mesh, the camera, the method and its params
+// and the notes about unknown fields. Defined in render_request.cpp, where /v1/render's reader
+// uses them, and request_camera.cpp; every reader throws ApiError (400 invalid_json or
 // invalid_request naming the field, 413 too_large) or render::InputError for the mesh.
 #pragma once
 
@@ -16,6 +16,7 @@
 #include "render/image/encode.h"
 #include "render/mesh/control_mesh.h"
 #include "render/mesh/mesh_cache.h"
+#include "render/pipeline/compare.h"
 #include "render/pipeline/render_job.h"
 
 namespace limn::api::request {
@@ -45,6 +46,24 @@ render::mesh::ControlMesh parseMesh(const rapidjson::Value& mesh,
 void parseSilhouetteParams(const rapidjson::Value& params,
                            const render::pipeline::JobLimits& limits,
                            render::pipeline::MethodParams& out);
+
+// "method" and "params" of /v1/render, with its field names in messages (POST /v1/compare
+// re-labels them: api/compare_request.cpp).
+render::pipeline::Method parseMethod(const rapidjson::Value& value);
+render::pipeline::MethodParams parseParams(const rapidjson::Value& params,
+                                           const render::pipeline::JobLimits& limits,
+                                           std::vector<std::string>& warnings);
+
+// One entry of /v1/compare's "methods" ({"method", "params", "shading", "label"} or just a
+// name), with `field` ("methods[2]") in every message; its label made when it has none, and its
+// params as given (JSON text) for the answer to echo. Defined in compare_request.cpp.
+struct ParsedMethod {
+  render::pipeline::CompareMethod method;
+  std::string label, paramsJson;
+};
+ParsedMethod parseCompareMethod(const rapidjson::Value& entry, const std::string& field,
+                                const render::pipeline::JobLimits& limits,
+                                std::vector<std::string>& warnings);
 
 // A 400 naming the camera field when the view cannot be drawn for this mesh: the eye on the
 // target (given, or the mesh's centre), an eye or target more than 1e6 bounding radii from the

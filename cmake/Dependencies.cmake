@@ -39,3 +39,6 @@ target_link_libraries(tinyobjloader_lib INTERFACE ${TINYOBJ_LIBRARY})
 # Headless OpenGL through EGL (GLVND).
 set(OpenGL_GL_PREFERENCE GLVND)
 find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
+
+# CLI11 (header only): the options of `limn batch`.
+find_package(CLI11 2.1 CONFIG REQUIRED)

@@ -22,6 +22,7 @@ packages=(
   libembree-dev libosd-dev libopenimageio-dev openimageio-tools libboost-dev rapidjson-dev
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
   libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev libmuparser-dev
+  libcli11-dev
 )
 if [ "$profile" = full ]; then
   packages+=(
@@ -32,6 +33,8 @@ if [ "$profile" = full ]; then
     clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
     # the implicit-surface benchmark's baseline (bench/implicit_vs_skimage.py)
     python3-skimage
+    # limn batch's plots (scripts/batch_plots.py, run by /usr/bin/python3)
+    python3-matplotlib
   )
   # The browser tests (tests/browser): Debian's chromium, and node + npm unless a node is there.
   packages+=(chromium)

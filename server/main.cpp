@@ -1,5 +1,6 @@
 // limn: the command line. `limn serve` runs the HTTP service; `limn render` runs one request
-// file through the same engine without HTTP and writes the answer and its images to a folder.
+// file through the same engine without HTTP and writes the answer and its images to a folder;
+// `limn batch` (server/batch_command.h) runs a batch of comparisons.
 #include <unistd.h>
 
 #include <csignal>
@@ -22,6 +23,7 @@
 #include "render/image/encode.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
+#include "server/batch_command.h"
 #include "server/http_server.h"
 #include "server/router.h"
 #include "server/worker_pool.h"
@@ -46,8 +48,10 @@ Usage:
       Endpoints: POST /v1/render (images and metrics), POST /v1/silhouette (the contour
       curves of the limit surface as JSON polylines or SVG, pieces marked visible or hidden),
       POST /v1/meshes (a mesh kept for later requests by id), POST /v1/tessellate (the
-      approximation as glTF, PLY or OBJ), GET / (the web page: open it in a browser),
-      /examples, /healthz, /readyz, /metrics, /openapi.json.
+      approximation as glTF, PLY or OBJ), POST /v1/compare (several methods against one
+      reference per camera), POST /v1/jobs, GET and DELETE /v1/jobs/{id} (a batch spec run
+      in the background), GET / (the web page: open it in a browser), /examples, /healthz,
+      /readyz, /metrics, /openapi.json.
 
   limn render REQUEST.json --out DIR [--config FILE]
       Runs one /v1/render request body through the engine without HTTP and writes
@@ -55,6 +59,19 @@ Usage:
         DIR/<pass>.png|exr        each requested image (color, mask, depth, normal, wireframe)
         DIR/reference_<pass>.*    the reference's images, when the request asks for them
       A request the service would refuse exits with status 2 and its JSON error on stderr.
+
+  limn batch SPEC.json --out DIR [--server URL] [--shard-count N [--shard-index K]]
+  limn batch --meshes DIR_OR_GLOB[,...] --methods coarse,uniform:3,adaptive:1,silhouette
+             --views N --size PX --out DIR
+      Compares many meshes x methods x views with the exact surface, on local render workers
+      (one per core) or through a running server (--server http://HOST:PORT, its
+      /v1/compare). Resumable: rows already in DIR/results*.jsonl are skipped. Writes
+        DIR/results.jsonl (sharded: DIR/results-shard-K.jsonl), and unsharded also
+        DIR/results.csv, DIR/summary.md, DIR/plots/*.svg|png, DIR/report.html
+      `limn batch --report DIR` writes the report of every results*.jsonl in DIR without
+      rendering. `limn batch --help` lists every option; docs/batch.md the spec.
+      Exit status: 0 every row computed, 4 some rows carry errors, 2 a spec or mesh refused,
+      3 the run could not finish (run it again to resume).
 
   limn help | --help      this text
   limn --version          the version
@@ -202,7 +219,11 @@ int serve(const CommandLine& cl) {
       access.authToken = token;
   }
   render::mesh::MeshCache meshCache(config->meshCacheBytes);
-  server::Router router(config->limits, pool, metrics, access, config->logLevel, &meshCache);
+  server::JobManager jobs(
+      pool, config->limits,
+      {config->maxJobs, config->maxJobRows, std::chrono::seconds(config->jobRetentionSeconds)},
+      &meshCache);
+  server::Router router(config->limits, pool, metrics, access, config->logLevel, &meshCache, &jobs);
   server::HttpOptions httpOptions;
   httpOptions.host = config->host;
   httpOptions.port = config->port;
@@ -221,6 +242,7 @@ int serve(const CommandLine& cl) {
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   std::cout << "limn listening on http://" << host << ":" << http->port() << std::endl;
   http->run();
+  jobs.stop();  // the pool has answered its last comparisons: the running job ends now
   // Every stage checks its cancel token well within a second; a worker that has not stopped
   // after this is stuck, and must not keep the process alive (nor may its thread be joined).
   constexpr std::chrono::milliseconds kStuckWorkerGrace{3'000};
@@ -333,6 +355,7 @@ int main(int argc, char** argv) {
     std::cout << "limn " << LIMN_VERSION << "\n";
     return 0;
   }
+  if (command == "batch") return server::batchCommand(argc, argv);
   if (command != "serve" && command != "render") return usageError("unknown command " + command);
 
   std::string error;

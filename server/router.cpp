@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "api/compare_api.h"
 #include "api/implicit_api.h"
 #include "api/openapi.h"
 #include "api/silhouette_api.h"
@@ -26,10 +27,39 @@ struct Route {
 
 // Every (path, method) limn answers; a known path with another method is a 405 listing these.
 constexpr Route kRoutes[] = {
-    {"/healthz", "GET"},      {"/readyz", "GET"},         {"/metrics", "GET"},
-    {"/openapi.json", "GET"}, {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
-    {"/v1/meshes", "POST"},   {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
+    {"/healthz", "GET"},         {"/readyz", "GET"},         {"/metrics", "GET"},
+    {"/openapi.json", "GET"},    {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
+    {"/v1/meshes", "POST"},      {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
+    {"/v1/compare", "POST"},     {"/v1/jobs", "POST"},       {"/v1/jobs/{id}", "GET"},
+    {"/v1/jobs/{id}", "DELETE"},
 };
+
+constexpr std::string_view kJobPrefix = "/v1/jobs/";
+
+// The path as kRoutes names it: /v1/jobs/<id> is "/v1/jobs/{id}".
+std::string_view routePath(std::string_view path) {
+  if (path.size() > kJobPrefix.size() && path.substr(0, kJobPrefix.size()) == kJobPrefix &&
+      path.find('/', kJobPrefix.size()) == std::string_view::npos) {
+    return "/v1/jobs/{id}";
+  }
+  return path;
+}
+
+// "offset" of a query string ("?offset=20"), 0 when absent or not a number.
+size_t offsetParameter(std::string_view target) {
+  const size_t query = target.find('?');
+  if (query == std::string_view::npos) return 0;
+  std::string_view rest = target.substr(query + 1);
+  const size_t at = rest.find("offset=");
+  if (at == std::string_view::npos || (at > 0 && rest[at - 1] != '&')) return 0;
+  size_t value = 0;
+  for (char c : rest.substr(at + 7)) {
+    if (c < '0' || c > '9') break;
+    value = value * 10 + static_cast<size_t>(c - '0');
+    if (value > (size_t{1} << 40)) break;
+  }
+  return value;
+}
 
 // The few JSON strings the service endpoints write (renderer names, error texts) go through
 // this; the request and response documents themselves belong to api/.
@@ -79,7 +109,7 @@ std::string_view pathOf(std::string_view target) {
 }
 
 std::string Router::routeLabel(std::string_view target) {
-  std::string_view path = pathOf(target);
+  std::string_view path = routePath(pathOf(target));
   for (const Route& route : kRoutes) {
     if (path == route.path) return std::string(path);
   }
@@ -88,11 +118,13 @@ std::string Router::routeLabel(std::string_view target) {
 }
 
 Router::Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, ServiceMetrics& metrics,
-               AccessOptions access, const std::string& logLevel, render::mesh::MeshCache* meshes)
+               AccessOptions access, const std::string& logLevel, render::mesh::MeshCache* meshes,
+               JobManager* jobs)
     : limits_(limits),
       pool_(pool),
       metrics_(metrics),
       meshes_(meshes),
+      jobs_(jobs),
       access_(std::move(access)),
       log_(logLevel),
       started_(std::chrono::steady_clock::now()) {}
@@ -124,7 +156,7 @@ WorkerPool::Abandon Router::route(Request request, Reply reply) {
   std::string_view path = pathOf(target);
   std::vector<std::string> allowed;
   for (const Route& route : kRoutes) {
-    if (path == route.path) allowed.emplace_back(route.method);
+    if (routePath(path) == route.path) allowed.emplace_back(route.method);
   }
   const EmbeddedFile* asset = findWebAsset(path);
   if (asset) allowed.emplace_back("GET");
@@ -161,6 +193,8 @@ WorkerPool::Abandon Router::route(Request request, Reply reply) {
     return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
   }
   if (path == "/v1/meshes") return uploadMesh(std::move(request.body), std::move(reply));
+  if (path == "/v1/compare") return compare(std::move(request.body), std::move(reply));
+  if (routePath(path) != path || path == "/v1/jobs") return jobs(request, std::move(reply));
   if (path == "/v1/tessellate") {
     return tessellate(std::move(request.body), std::move(request.accept), std::move(reply));
   }
@@ -224,6 +258,38 @@ WorkerPool::Abandon Router::implicit(std::string body, std::string accept, Reply
         return api::handleImplicit(body, accept, limits, context, cancel);
       },
       std::move(reply));
+}
+
+// Several methods against one reference per camera: one job on one worker (the request's
+// deadline covers all of its rows).
+WorkerPool::Abandon Router::compare(std::string body, Reply reply) {
+  return pool_.submit(
+      [body = std::move(body), limits = limits_, meshes = meshes_](
+          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
+        return api::handleCompare(body, limits, context, cancel, meshes);
+      },
+      std::move(reply));
+}
+
+// A job's spec (its meshes) is read on a worker, like an upload; its state and cancellation are
+// answered at once. The rows themselves go through the pool as comparisons (server/jobs.h).
+WorkerPool::Abandon Router::jobs(const Request& request, Reply reply) {
+  std::string_view path = pathOf(request.target);
+  if (!jobs_) {
+    reply(api::errorAnswer(
+        {404, "not_found", "this server runs no jobs", "{\"path\":" + jsonString(path) + "}"}));
+    return {};
+  }
+  if (path == "/v1/jobs") {
+    return pool_.submit([jobs = jobs_, body = request.body](
+                            render::pipeline::RenderContext&,
+                            const render::CancelToken&) { return jobs->create(body); },
+                        std::move(reply));
+  }
+  const std::string id(path.substr(kJobPrefix.size()));
+  reply(request.method == "DELETE" ? jobs_->cancel(id)
+                                   : jobs_->get(id, offsetParameter(request.target)));
+  return {};
 }
 
 // Contours need no GL context, but share the render workers: one queue, one set of limits and

@@ -14,6 +14,9 @@
 //   POST /v1/meshes     api::handleMeshUpload on a worker thread, into the MeshCache
 //   POST /v1/tessellate api::handleTessellate on a worker thread (the mesh, no raster)
 //   POST /v1/implicit   api::handleImplicit on a worker thread (an implicit field's scene)
+//   POST /v1/compare    api::handleCompare on a worker thread (methods x cameras, one job)
+//   POST /v1/jobs       JobManager::create on a worker thread (a batch spec, run in the back)
+//   GET, DELETE /v1/jobs/{id}   JobManager::get / cancel, at once
 //   GET  /, /NAME.js, /examples, /examples/NAME   the built-in page and examples (web_assets.h)
 #pragma once
 
@@ -26,6 +29,7 @@
 #include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
 #include "server/access.h"
+#include "server/jobs.h"
 #include "server/request_log.h"
 #include "server/service_metrics.h"
 #include "server/web_assets.h"
@@ -47,10 +51,11 @@ class Router {
   using Reply = std::function<void(api::Answer)>;
 
   // `metrics` (shared with the pool, which records its jobs there) must outlive the router.
-  // `meshes` (owned by the caller, may be null: no uploads) holds POST /v1/meshes' meshes.
+  // `meshes` (owned by the caller, may be null: no uploads) holds POST /v1/meshes' meshes;
+  // `jobs` (the same; null: no /v1/jobs) runs POST /v1/jobs.
   Router(const render::pipeline::JobLimits& limits, WorkerPool& pool, ServiceMetrics& metrics,
          AccessOptions access = {}, const std::string& logLevel = "info",
-         render::mesh::MeshCache* meshes = nullptr);
+         render::mesh::MeshCache* meshes = nullptr, JobManager* jobs = nullptr);
 
   // Calls `reply` exactly once: before returning for everything but renders, from a worker or
   // the pool's watchdog for renders. For work that went to the pool, returns the handle that
@@ -73,6 +78,8 @@ class Router {
   WorkerPool::Abandon uploadMesh(std::string body, Reply reply);
   WorkerPool::Abandon tessellate(std::string body, std::string accept, Reply reply);
   WorkerPool::Abandon implicit(std::string body, std::string accept, Reply reply);
+  WorkerPool::Abandon compare(std::string body, Reply reply);
+  WorkerPool::Abandon jobs(const Request& request, Reply reply);
   api::Answer webAsset(const EmbeddedFile& file) const;
 
   WorkerPool::Abandon route(Request request, Reply reply);
@@ -81,6 +88,7 @@ class Router {
   WorkerPool& pool_;
   ServiceMetrics& metrics_;
   render::mesh::MeshCache* meshes_;
+  JobManager* jobs_;
   Access access_;
   RequestLog log_;
   std::chrono::steady_clock::time_point started_;

@@ -85,16 +85,17 @@ void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
 }
 
 // The supersampled mask, S x S rays only in the pixels that need them (result.refinedPixels).
+// The hint is a mask (one method's) or its blocks (several methods' merged).
 void castSupersampledMask(const ReferenceScene& built, RTCScene scene, const Camera& camera,
-                          const std::vector<PixelHit>& hits, int s, const Image* hint,
+                          const std::vector<PixelHit>& hits, int s, const ReferenceOptions& options,
                           const CancelToken& cancel, ReferenceResult& result) {
   const int width = camera.width(), height = camera.height();
   std::vector<char> coverage(hits.size());
   for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
-  if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
-    hint = nullptr;
-  }
-  result.refinedPixels = pixelsToRefine(coverage, built.outlineCandidates, width, height, hint, s);
+  result.refinedPixels =
+      options.hintBlocks
+          ? pixelsToRefine(coverage, built.outlineCandidates, width, height, options.hintBlocks)
+          : pixelsToRefine(coverage, built.outlineCandidates, width, height, options.maskHint, s);
   size_t refined = 0;
   for (char r : result.refinedPixels) refined += r != 0;
   result.stats.refinedPixels = refined;
@@ -154,8 +155,7 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 
   if (passes.supersample > 0) {
     start = Clock::now();
-    castSupersampledMask(*built, scene, camera, hits, passes.supersample, options.maskHint, cancel,
-                         result);
+    castSupersampledMask(*built, scene, camera, hits, passes.supersample, options, cancel, result);
     stats.maskMs = msSince(start);
     if (options.locateOutline) {
       start = Clock::now();

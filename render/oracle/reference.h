@@ -11,6 +11,7 @@
 // it costs about as much as the reference), and the two masks' disagreement is reported.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,11 +51,24 @@ struct ReferenceResult {
   std::vector<std::string> warnings;
 };
 
+// What the S x S block of each output pixel of a supersampled mask holds: kBlockUncovered,
+// kBlockCovered or both bits (mixed). Blocks of several masks (the methods of a comparison)
+// merge by OR: a pixel is then "mixed or disagreeing" for the union exactly when it is so for
+// one of them, so one reference hinted with the merged blocks is as exact, wherever any of
+// those masks has an outline, as a reference hinted with each mask alone.
+inline constexpr uint8_t kBlockUncovered = 1, kBlockCovered = 2;
+// `supersampledMask` is at `s` times the output size (one channel, covered above 0.5).
+std::vector<uint8_t> maskBlocks(const Image& supersampledMask, int s);
+// into |= blocks (into may start empty); blocks of different sizes throw std::invalid_argument.
+void mergeMaskBlocks(std::vector<uint8_t>& into, const std::vector<uint8_t>& blocks);
+
 struct ReferenceOptions {
   // A mask at S times the output size (the approximation's): output pixels where its S x S
   // block is not uniform, or disagrees with the reference's own pixel, get all their samples
   // cast too, so the reference's mask is exact wherever either side has an outline.
   const Image* maskHint = nullptr;
+  // The same hint as blocks (maskBlocks, merged over several masks); taken over maskHint.
+  const std::vector<uint8_t>* hintBlocks = nullptr;
   bool locateOutline = false;            // needs passes.supersample > 0
   ReferenceSceneCache* cache = nullptr;  // where to find and keep the tessellation and BVH
 };

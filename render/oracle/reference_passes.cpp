@@ -4,33 +4,53 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <stdexcept>
 
 #include "render/oracle/ray_caster.h"
+#include "render/oracle/reference.h"
 
 namespace limn::render::oracle {
 
-std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
-                                 int width, int height, const Image* hint, int s) {
-  constexpr uint8_t kSomeUncovered = 1, kSomeCovered = 2;
+std::vector<uint8_t> maskBlocks(const Image& supersampledMask, int s) {
+  const int width = supersampledMask.width / s, height = supersampledMask.height / s;
+  std::vector<uint8_t> blocks(static_cast<size_t>(width) * height, 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
-    std::vector<uint8_t> hintBlocks(width);  // what each block of the hint holds, row by row
     for (int y = r.begin(); y < r.end(); ++y) {
-      if (hint) {
-        std::fill(hintBlocks.begin(), hintBlocks.end(), uint8_t{0});
-        for (int j = y * s; j < (y + 1) * s; ++j) {
-          const float* row = &hint->pixels[static_cast<size_t>(j) * hint->width];
-          for (int x = 0; x < width; ++x) {
-            uint8_t seen = 0;
-            for (int i = x * s; i < (x + 1) * s; ++i)
-              seen |= row[i] > 0.5f ? kSomeCovered : kSomeUncovered;
-            hintBlocks[x] |= seen;
-          }
+      uint8_t* out = &blocks[static_cast<size_t>(y) * width];
+      for (int j = y * s; j < (y + 1) * s; ++j) {
+        const float* row =
+            &supersampledMask.pixels[static_cast<size_t>(j) * supersampledMask.width];
+        for (int x = 0; x < width; ++x) {
+          uint8_t seen = 0;
+          for (int i = x * s; i < (x + 1) * s; ++i)
+            seen |= row[i] > 0.5f ? kBlockCovered : kBlockUncovered;
+          out[x] |= seen;
         }
       }
+    }
+  });
+  return blocks;
+}
+
+void mergeMaskBlocks(std::vector<uint8_t>& into, const std::vector<uint8_t>& blocks) {
+  if (into.empty()) {
+    into = blocks;
+    return;
+  }
+  if (into.size() != blocks.size()) throw std::invalid_argument("mask blocks of different sizes");
+  for (size_t p = 0; p < into.size(); ++p) into[p] |= blocks[p];
+}
+
+std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
+                                 int width, int height, const std::vector<uint8_t>* hint) {
+  if (hint && hint->size() != covered.size()) hint = nullptr;
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y) {
       for (int x = 0; x < width; ++x) {
         const size_t p = static_cast<size_t>(y) * width + x;
         if (refine[p]) continue;
-        bool differs = hint && hintBlocks[x] != (covered[p] ? kSomeCovered : kSomeUncovered);
+        bool differs = hint && (*hint)[p] != (covered[p] ? kBlockCovered : kBlockUncovered);
         for (int dy = -1; dy <= 1 && !differs; ++dy) {
           for (int dx = -1; dx <= 1 && !differs; ++dx) {
             int nx = x + dx, ny = y + dy;
@@ -43,6 +63,15 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<c
     }
   });
   return refine;
+}
+
+std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
+                                 int width, int height, const Image* hint, int s) {
+  if (!hint || hint->width != width * s || hint->height != height * s || hint->channels != 1) {
+    return pixelsToRefine(covered, std::move(refine), width, height, nullptr);
+  }
+  const std::vector<uint8_t> blocks = maskBlocks(*hint, s);
+  return pixelsToRefine(covered, std::move(refine), width, height, &blocks);
 }
 
 metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,

@@ -3,6 +3,7 @@
 // full, and a coverage query on a scene for the outline search.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "render/core/camera.h"
@@ -59,7 +60,10 @@ struct PassImages {
 
 // Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
 // `refine` (outline candidates known beforehand), those with an 8-neighbour of other coverage,
-// and those where the hint's block is mixed or disagrees with the pixel.
+// and those where the hint's block (oracle::maskBlocks) is mixed or disagrees with the pixel.
+std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
+                                 int width, int height, const std::vector<uint8_t>* hint);
+// The same with the hint a mask at `s` times the size (ignored when it is not).
 std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
                                  int width, int height, const Image* hint, int s);
 

@@ -6,28 +6,41 @@
 
 namespace limn::render::pipeline {
 
+metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet& images,
+                               const Camera& camera, int S,
+                               const oracle::ReferenceResult& reference, double diagonal, bool diff,
+                               const CancelToken& cancel) {
+  const ImageSet& refImages = reference.images;
+  metrics::Metrics m;
+  m.silhouette =
+      metrics::compareSilhouettes(images.supersampledMask, refImages.supersampledMask, S, cancel);
+  // The reference was hinted with this mask: its refined pixels hold all of its outline.
+  metrics::Outline outline = oracle::locateMeshOutline(approx, camera, images.supersampledMask, S,
+                                                       cancel, &reference.refinedPixels);
+  metrics::OutlineDistances d = metrics::compareOutlines(
+      outline, reference.outline, std::hypot(camera.width(), camera.height()));
+  m.silhouette->outlineHausdorffPx = d.hausdorffPx;
+  m.silhouette->outlineMeanPx = d.meanPx;
+  m.image = metrics::compareColor(images, refImages);
+  m.depth = metrics::compareDepth(images, refImages, diagonal);
+  m.normal = metrics::compareNormals(images, refImages);
+  if (diff) {
+    metrics::DiffImage heat = metrics::colorDifference(images, refImages);
+    m.image->diffScale = heat.scale;
+    images.passes[pass::kDiff] = std::move(heat.image);
+  }
+  return m;
+}
+
 void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camera& camera, int S,
                              const oracle::ReferenceResult& reference, double diagonal, bool diff,
                              const CancelToken& cancel, RenderResult& result) {
-  const ImageSet& approxImages = result.images;
-  const ImageSet& refImages = reference.images;
-  result.metrics.silhouette = metrics::compareSilhouettes(approxImages.supersampledMask,
-                                                          refImages.supersampledMask, S, cancel);
-  // The reference was hinted with this mask: its refined pixels hold all of its outline.
-  metrics::Outline outline = oracle::locateMeshOutline(
-      approx, camera, approxImages.supersampledMask, S, cancel, &reference.refinedPixels);
-  metrics::OutlineDistances d = metrics::compareOutlines(
-      outline, reference.outline, std::hypot(camera.width(), camera.height()));
-  result.metrics.silhouette->outlineHausdorffPx = d.hausdorffPx;
-  result.metrics.silhouette->outlineMeanPx = d.meanPx;
-  result.metrics.image = metrics::compareColor(approxImages, refImages);
-  result.metrics.depth = metrics::compareDepth(approxImages, refImages, diagonal);
-  result.metrics.normal = metrics::compareNormals(approxImages, refImages);
-  if (diff) {
-    metrics::DiffImage heat = metrics::colorDifference(approxImages, refImages);
-    result.metrics.image->diffScale = heat.scale;
-    result.images.passes[pass::kDiff] = std::move(heat.image);
-  }
+  metrics::Metrics m =
+      measureImages(approx, result.images, camera, S, reference, diagonal, diff, cancel);
+  result.metrics.silhouette = m.silhouette;
+  result.metrics.image = m.image;
+  result.metrics.depth = m.depth;
+  result.metrics.normal = m.normal;
 }
 
 ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference) {

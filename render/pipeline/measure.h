@@ -4,15 +4,23 @@
 
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
+#include "render/metrics/metrics.h"
 #include "render/oracle/reference.h"
 #include "render/pipeline/render_job.h"
 #include "render/tessellate/triangle_mesh.h"
 
 namespace limn::render::pipeline {
 
-// result.images (the approximation's passes at supersample S) against `reference` (cast with the
-// approximation's mask as its hint): silhouette metrics with the continuous outline distances,
-// colour, depth (relative to `diagonal`) and normal metrics, and the diff image when asked.
+// `images` (the approximation's passes at supersample S) against `reference` (cast with the
+// approximation's mask as its hint, alone or merged with others': oracle::maskBlocks):
+// silhouette metrics with the continuous outline distances, colour, depth (relative to
+// `diagonal`) and normal metrics; with `diff`, the heat map goes into `images`.
+metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet& images,
+                               const Camera& camera, int S,
+                               const oracle::ReferenceResult& reference, double diagonal, bool diff,
+                               const CancelToken& cancel);
+
+// The same into result.metrics, for result.images.
 void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camera& camera, int S,
                              const oracle::ReferenceResult& reference, double diagonal, bool diff,
                              const CancelToken& cancel, RenderResult& result);

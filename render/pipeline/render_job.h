@@ -73,6 +73,9 @@ struct JobLimits {
   int maxPrimitives = 64;
   int maxResolution = 512;
   size_t maxExpressionLength = 256;
+  // Rows of one comparison (methods x cameras): each camera holds every method's images at
+  // once (about 100 MB per method at 1024^2, S = 4) until its reference is built.
+  size_t maxCompareRows = 64;
 };
 
 struct RenderJob {

@@ -1,0 +1,148 @@
+#include "render/pipeline/compare.h"
+
+#include <functional>
+#include <string>
+
+#include "render/pipeline/drawing.h"
+#include "render/pipeline/job_checks.h"
+#include "render/pipeline/measure.h"
+#include "render/subdiv/limit_surface.h"
+
+namespace limn::render::pipeline {
+
+namespace {
+
+// Runs `check`, re-throwing an InputError with its subject placed under `prefix`
+// ("params.level" -> "methods[2].params.level"); a limit keeps its key as the subject (clients
+// read the limit's name there) and gets the prefix in its message instead.
+void within(const std::string& prefix, const std::function<void()>& check) {
+  try {
+    check();
+  } catch (const InputError& e) {
+    if (e.kind() == InputError::Kind::LimitExceeded) {
+      throw InputError(e.kind(), e.subject(), prefix + ": " + e.what());
+    }
+    throw InputError(e.kind(), prefix + "." + e.subject(), prefix + "." + e.what());
+  }
+}
+
+MethodChoice choiceOf(const CompareJob& job, size_t m) {
+  const CompareMethod& method = job.methods[m];
+  return {job.mesh, method.method, method.params, method.shading, job.outputs};
+}
+
+// Everything the request could get wrong, before any work.
+void checkCompare(const CompareJob& job, const JobLimits& limits) {
+  if (job.methods.empty()) badParameter("methods", "must list at least one method");
+  if (job.cameras.empty()) badParameter("cameras", "must list at least one camera");
+  const size_t rows = job.methods.size() * job.cameras.size();
+  if (rows > limits.maxCompareRows) {
+    throw InputError(InputError::Kind::LimitExceeded, "maxCompareRows",
+                     std::to_string(job.methods.size()) + " methods x " +
+                         std::to_string(job.cameras.size()) + " cameras = " + std::to_string(rows) +
+                         " rows: exceeds limit maxCompareRows (" +
+                         std::to_string(limits.maxCompareRows) + ")");
+  }
+  if (job.metricSupersample < 1 || job.metricSupersample > limits.maxSupersample) {
+    badParameter("metricSupersample", "must be in 1.." + std::to_string(limits.maxSupersample));
+  }
+  for (size_t m = 0; m < job.methods.size(); ++m) {
+    const std::string prefix = "methods[" + std::to_string(m) + "]";
+    if (job.methods[m].method == Method::Limit) {
+      badParameter(prefix + ".method",
+                   "\"limit\" is the reference every row is measured against; list the methods "
+                   "to compare with it");
+    }
+    within(prefix, [&] { checkMethod(choiceOf(job, m), limits); });
+  }
+  for (size_t c = 0; c < job.cameras.size(); ++c) {
+    within("cameras[" + std::to_string(c) + "]", [&] {
+      checkImageSides(job.cameras[c], limits);
+      checkSupersampledMasks(job.cameras[c], job.metricSupersample, limits);
+    });
+  }
+}
+
+// Every method for camera `c`: drawn first, then one reference hinted with all their masks,
+// then each measured against it. A drawing's images are let go as soon as its row is measured.
+void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
+                   const subdiv::LimitSurface& surface, RenderContext& context,
+                   const CancelToken& cancel, CompareResult& result) {
+  const Camera camera = resolveCamera(job.cameras[c], surface.bounds());
+  const int S = job.metricSupersample;
+  std::vector<CompareRow> rows(job.methods.size());
+  std::vector<std::optional<MethodDrawing>> drawings(job.methods.size());
+  std::vector<uint8_t> hint;
+  for (size_t m = 0; m < job.methods.size(); ++m) {
+    rows[m].method = m;
+    rows[m].camera = c;
+    try {
+      drawings[m] = drawMethod(choiceOf(job, m), limits, surface, camera, context, true, S, cancel);
+      oracle::mergeMaskBlocks(hint, oracle::maskBlocks(drawings[m]->images.supersampledMask, S));
+    } catch (const InputError& e) {
+      rows[m].error = RowError{e.kind(), e.subject(), e.what()};
+    }
+  }
+
+  CompareReference ref{
+      .camera = camera, .stats = {}, .referenceMs = 0, .images = {}, .warnings = {}};
+  if (!hint.empty()) {  // else every method failed: nothing to measure
+    Stopwatch clock;
+    oracle::ReferenceResult reference =
+        oracle::renderReference(surface, camera, referencePasses(true, S), cancel,
+                                {.maskHint = nullptr,
+                                 .hintBlocks = &hint,
+                                 .locateOutline = true,
+                                 .cache = context.referenceCache});
+    ref.referenceMs = clock.lapMs();
+    ref.stats = reference.stats;
+    ref.warnings = reference.warnings;
+    cancel.check();
+    for (size_t m = 0; m < job.methods.size(); ++m) {
+      if (!drawings[m]) continue;
+      CompareRow& row = rows[m];
+      Stopwatch metricsClock;
+      row.metrics =
+          measureDrawing(*drawings[m], reference, surface, camera, S, job.outputs.diff, cancel);
+      const Approximated& approx = drawings[m]->approx;
+      row.stats = approx.stats;
+      row.stats.controlVertices = job.mesh.vertexCount();
+      row.stats.controlFaces = job.mesh.faceCount();
+      row.stats.referenceTriangles = reference.stats.triangles;
+      row.warnings = approx.warnings;
+      row.timings.approxMs = approx.approxMs;
+      row.timings.rasterMs = drawings[m]->rasterMs;
+      row.timings.metricsMs = metricsClock.lapMs();
+      row.timings.totalMs = row.timings.approxMs + row.timings.rasterMs + row.timings.metricsMs;
+      row.images = selectOutputs(std::move(drawings[m]->images), job.outputs, false);
+      drawings[m].reset();
+      cancel.check();
+    }
+    ref.images = selectOutputs(std::move(reference.images), job.outputs, true);
+  }
+  result.references.push_back(std::move(ref));
+  for (CompareRow& row : rows) result.rows.push_back(std::move(row));
+}
+
+}  // namespace
+
+CompareResult compare(const CompareJob& job, const JobLimits& limits, RenderContext& context,
+                      const CancelToken& cancel) {
+  Stopwatch clock, total;
+  checkCompare(job, limits);
+  mesh::validateMesh(job.mesh, limits.mesh);
+  cancel.check();
+  const subdiv::LimitSurface surface(job.mesh, cancel);
+  CompareResult result;
+  result.surfaceMs = clock.lapMs();
+  result.controlVertices = job.mesh.vertexCount();
+  result.controlFaces = job.mesh.faceCount();
+  for (size_t c = 0; c < job.cameras.size(); ++c) {
+    cancel.check();
+    compareCamera(job, c, limits, surface, context, cancel, result);
+  }
+  result.totalMs = total.lapMs();
+  return result;
+}
+
+}  // namespace limn::render::pipeline

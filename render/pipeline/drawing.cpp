@@ -1,0 +1,190 @@
+#include "render/pipeline/drawing.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "render/core/error.h"
+#include "render/normalmap/mapped_cage.h"
+#include "render/normalmap/normal_atlas.h"
+#include "render/pipeline/job_checks.h"
+#include "render/pipeline/measure.h"
+#include "render/pipeline/silhouette_build.h"
+#include "render/raster/rasterizer.h"
+#include "render/rules/refine.h"
+#include "render/silhouette/contour_overlay.h"
+#include "render/tessellate/cage_overlay.h"
+#include "render/tessellate/tessellate.h"
+
+namespace limn::render::pipeline {
+
+namespace {
+
+// Normal-map shading: an atlas of the limit normals of `surface`'s faces, sized so the face
+// that looks largest gets about half a texel per pixel (bilinear filtering does the rest),
+// with at most 64 x 64 texels per face and 4M texels in all.
+normalmap::NormalAtlas makeAtlas(const subdiv::LimitSurface& surface, const Camera& camera) {
+  constexpr size_t kTexelBudget = size_t{1} << 22;
+  constexpr int kMaxSide = 4096, kMaxChartTexels = 64;
+  int texels = normalmap::chartTexelsForCamera(surface, camera, 0.5, kTexelBudget, kMaxSide,
+                                               kMaxChartTexels);
+  return normalmap::NormalAtlas(surface, texels, kMaxSide);
+}
+
+// Atlas coordinates for a mesh whose vertices each belong to one face (the silhouette mesh):
+// read off the face and (u, v) its triangles record.
+void mapNormals(tessellate::TriangleMesh& mesh, const normalmap::NormalAtlas& atlas) {
+  mesh.texcoords.assign(mesh.positions.size(), Vec2f{});
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec2f& uv = mesh.cornerUVs[3 * t + k];
+      mesh.texcoords[mesh.indices[3 * t + k]] =
+          atlas.coordinate(mesh.triangleFaces[t], Vec2{uv.x, uv.y});
+    }
+  }
+  mesh.normalMap = atlas.image();
+}
+
+// The methods that tessellate the surface directly (all but silhouette).
+tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobLimits& limits,
+                                          const subdiv::LimitSurface& surface, const Camera& camera,
+                                          const CancelToken& cancel) {
+  switch (choice.method) {
+    case Method::Coarse:
+      if (choice.shading == Shading::NormalMap) {
+        return normalmap::mappedCage(surface, makeAtlas(surface, camera));
+      }
+      return tessellate::tessellateCoarse(surface);
+    case Method::Uniform: {
+      tessellate::UniformOptions options;
+      options.level = choice.params.level;
+      options.engine = choice.params.engine == Engine::Masks ? tessellate::UniformEngine::Masks
+                       : choice.params.engine == Engine::Factored
+                           ? tessellate::UniformEngine::Factored
+                           : tessellate::UniformEngine::OpenSubdiv;
+      options.pushToLimit = choice.params.pushToLimit;
+      options.maxTriangles = limits.maxTriangles;
+      return tessellate::tessellateUniform(surface, options);
+    }
+    case Method::Adaptive: {
+      tessellate::AdaptiveOptions options;
+      options.dicingRate = choice.params.dicingRate;
+      options.maxTriangles = limits.maxTriangles;
+      return tessellate::tessellateAdaptive(surface, camera, options, cancel);
+    }
+    case Method::Limit:
+    case Method::Silhouette:
+      break;
+  }
+  throw std::logic_error(std::string("method ") + methodName(choice.method) +
+                         " is not tessellated here");
+}
+
+}  // namespace
+
+Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limits,
+                               const subdiv::LimitSurface& surface, const Camera& camera,
+                               const CancelToken& cancel) {
+  Stopwatch clock;
+  Approximated out;
+  if (choice.method == Method::Silhouette) {
+    const MethodParams& p = choice.params;
+    SilhouetteBuild build =
+        buildSilhouette(surface, camera, {p.presubdivide, p.searchSteps, p.curveSamples, p.contour},
+                        limits.maxTriangles, cancel, out.warnings);
+    out.presubdivided = std::move(build.presubdivided);
+    out.stats.presubdivided = out.presubdivided != nullptr;
+    out.stats.silhouette = build.built.stats;
+    if (choice.outputs.contours) {
+      out.overlays.push_back(
+          silhouette::contourOverlay(out.drawnOn(surface), build.built, pass::kContours));
+    }
+    out.mesh = std::move(build.built.mesh);
+  } else {
+    out.mesh = tessellateMethod(choice, limits, surface, camera, cancel);
+  }
+  if (choice.outputs.cage) {
+    out.overlays.push_back(tessellate::cageOverlay(choice.mesh, pass::kCage));  // the client's
+  }
+  out.stats.triangles = out.mesh.triangleCount();
+  out.stats.vertices = out.mesh.vertexCount();
+  out.approxMs = clock.lapMs();
+  return out;
+}
+
+MethodDrawing drawMethod(const MethodChoice& choice, const JobLimits& limits,
+                         const subdiv::LimitSurface& surface, const Camera& camera,
+                         RenderContext& context, bool measured, int supersample,
+                         const CancelToken& cancel) {
+  MethodDrawing drawing{.approx = approximateMethod(choice, limits, surface, camera, cancel),
+                        .images = {},
+                        .rasterMs = 0};
+  Stopwatch clock;
+  if (choice.method == Method::Silhouette && choice.shading == Shading::NormalMap) {
+    mapNormals(drawing.approx.mesh, makeAtlas(drawing.approx.drawnOn(surface), camera));
+  }
+  drawing.approx.approxMs += clock.lapMs();
+  cancel.check();
+
+  const Outputs& outputs = choice.outputs;
+  PassSelection passes{.color = outputs.color || measured,
+                       .mask = outputs.mask || measured,
+                       .depth = outputs.depth || measured,
+                       .normal = outputs.normal || measured,
+                       .wireframe = outputs.wireframe,
+                       .supersample = measured ? supersample : 0};
+  if (context.rasterizer == nullptr) throw std::runtime_error("no rasterizer in this context");
+  drawing.images = context.rasterizer->render(drawing.approx.mesh, camera, passes, choice.shading,
+                                              drawing.approx.overlays, cancel);
+  drawing.rasterMs = clock.lapMs();
+  cancel.check();
+  return drawing;
+}
+
+PassSelection referencePasses(bool measured, int supersample) {
+  return {.color = true,
+          .mask = true,
+          .depth = true,
+          .normal = true,
+          .supersample = measured ? supersample : 0};
+}
+
+metrics::Metrics measureDrawing(MethodDrawing& drawing, const oracle::ReferenceResult& reference,
+                                const subdiv::LimitSurface& surface, const Camera& camera,
+                                int supersample, bool diff, const CancelToken& cancel) {
+  metrics::Metrics m = measureImages(drawing.approx.mesh, drawing.images, camera, supersample,
+                                     reference, surface.bounds().diagonal(), diff, cancel);
+  // Silhouette meshes live on the pre-subdivided copy: the same limit surface, finer faces.
+  m.geometry = metrics::measureGeometry(drawing.approx.mesh, drawing.approx.drawnOn(surface));
+  return m;
+}
+
+void checkMethod(const MethodChoice& choice, const JobLimits& limits) {
+  const MethodParams& p = choice.params;
+  if (choice.shading == Shading::NormalMap && choice.method != Method::Silhouette &&
+      choice.method != Method::Coarse) {
+    badParameter("shading",
+                 "\"normal-map\" is available with methods \"silhouette\" and "
+                 "\"coarse\" (the others draw limit normals per vertex)");
+  }
+  if (choice.method == Method::Uniform && p.engine != Engine::OpenSubdiv) {
+    std::string whyNot = rules::unsupportedReason(
+        choice.mesh, p.engine == Engine::Masks ? rules::Method::Masks : rules::Method::Factored);
+    if (!whyNot.empty()) {
+      const char* name = p.engine == Engine::Masks ? "\"masks\"" : "\"factored\"";
+      badParameter("params.engine", std::string(name) + " cannot refine this mesh: " + whyNot);
+    }
+  }
+  if (p.level < 0 || p.level > limits.maxLevel) {
+    badParameter("params.level", "must be in 0.." + std::to_string(limits.maxLevel));
+  }
+  if (!(p.dicingRate >= limits.minDicingRate)) {
+    badParameter("params.dicingRate", "must be >= " + std::to_string(limits.minDicingRate));
+  }
+  checkSilhouetteParams(p.searchSteps, p.curveSamples, limits);
+  if (p.metricSupersample < 1 || p.metricSupersample > limits.maxSupersample) {
+    badParameter("params.metricSupersample",
+                 "must be in 1.." + std::to_string(limits.maxSupersample));
+  }
+}
+
+}  // namespace limn::render::pipeline
