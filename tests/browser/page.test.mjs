@@ -338,14 +338,15 @@ describe("limn's page", () => {
   });
   it("renders an implicit scene, with its polygoniser and the reference", async () => {
     const options = await page.$$eval("#example option", (os) => os.map((o) => o.value));
-    assert.ok(options.includes("scene:metaball_figure"), `no implicit scenes in ${options}`);
+    assert.ok(options.includes("scene:metaball_figure") && options.includes("scene:sphere_bite"),
+              `no implicit scenes in ${options}`);
     const before = await page.evaluate(() => window.limnPage.renders);
-    await page.selectOption("#example", "scene:metaball_figure");
+    await page.selectOption("#example", "scene:sphere_bite");  // the quickest reference
     await waitForRenders(before + 1);
     assert.ok(await page.isVisible("#polygonizer"), "the polygoniser controls are hidden");
     assert.ok(!(await page.isVisible("#method")), "the mesh method control still shows");
-    assert.match(await page.textContent("#mesh-info"), /implicit field of 12 primitives/);
-    assert.match(await page.textContent("#stats"), /closed · 12 primitives/);
+    assert.match(await page.textContent("#mesh-info"), /implicit field of 2 primitives/);
+    assert.match(await page.textContent("#stats"), /closed · 2 primitives/);
     assert.ok(await inkFraction("#picture") > 0.02, "the scene's picture is blank");
     const answer = await page.evaluate(() => window.limnPage.lastAnswer);
     assert.equal(answer.stats.implicit.polygonizer, "marching-cubes");
