@@ -257,10 +257,11 @@ BatchSpec parseBatchSpec(std::string_view text, const JobLimits& limits) {
   if (!root.IsObject()) json::fail("", "a batch spec must be a JSON object");
   for (const auto& member : std::as_const(root).GetObject()) {
     std::string_view name(member.name.GetString(), member.name.GetStringLength());
-    if (name != "meshes" && name != "methods" && name != "cameras" && name != "size" &&
-        name != "supersample") {
-      json::fail(std::string(name), "the batch spec has no field " + json::quote(name) +
-                                        " (meshes, methods, cameras, size, supersample)");
+    if (name != "meshes" && name != "methods" && name != "cameras" && name != "views" &&
+        name != "seed" && name != "size" && name != "supersample") {
+      json::fail(std::string(name),
+                 "the batch spec has no field " + json::quote(name) +
+                     " (meshes, methods, cameras, views, seed, size, supersample)");
     }
   }
   BatchSpec spec;
@@ -282,11 +283,28 @@ BatchSpec parseBatchSpec(std::string_view text, const JobLimits& limits) {
       spec.methods.push_back(std::move(v));
     }
   }
-  const Value& cameras = list("cameras");
-  for (rapidjson::SizeType i = 0; i < cameras.Size(); ++i) {
-    for (ViewSpec& v : parseViewEntry(cameras[i], "cameras[" + std::to_string(i) + "]", limits)) {
+  if (json::find(root, "cameras") || !json::find(root, "views")) {
+    const Value& cameras = list("cameras");
+    for (rapidjson::SizeType i = 0; i < cameras.Size(); ++i) {
+      for (ViewSpec& v : parseViewEntry(cameras[i], "cameras[" + std::to_string(i) + "]", limits)) {
+        spec.views.push_back(std::move(v));
+      }
+    }
+  }
+  // "views": N (and "seed") is the spec's --views: N seeded orbit views after the cameras.
+  if (const Value* views = json::find(root, "views")) {
+    const int count = json::integer(*views, "views");
+    if (count < 1 || count > 1000) json::fail("views", "views must be in 1..1000");
+    double seed = 1;
+    if (const Value* v = json::find(root, "seed")) seed = json::number(*v, "seed");
+    if (!(seed >= 0 && seed == std::floor(seed) && seed < 9007199254740992.0)) {
+      json::fail("seed", "seed must be a non-negative integer");
+    }
+    for (ViewSpec& v : seededViews(count, static_cast<uint64_t>(seed))) {
       spec.views.push_back(std::move(v));
     }
+  } else if (json::find(root, "seed")) {
+    json::fail("seed", "seed is the seed of \"views\": give views too");
   }
   dropDuplicates<MethodVariant>(spec.methods, [](const MethodVariant& m) { return m.key(); });
   dropDuplicates<ViewSpec>(spec.views, [](const ViewSpec& v) { return v.cameraJson; });

@@ -219,15 +219,20 @@ Local localPool(const api::ServiceConfig& config, int workers) {
   return local;
 }
 
-int runBatch(const Options& o, const CLI::App& app) {
-  api::ServiceConfig config;
-  if (!o.config.empty()) {
-    try {
-      config = api::loadConfig(o.config);
-    } catch (const std::exception& e) {
-      throw Failure{1, e.what()};
-    }
+// --config FILE, else LIMN_CONFIG (what limn serve reads too: a container sets it once).
+api::ServiceConfig readConfig(const Options& o) {
+  std::string path = o.config;
+  if (const char* env = std::getenv("LIMN_CONFIG"); path.empty() && env && *env) path = env;
+  if (path.empty()) return {};
+  try {
+    return api::loadConfig(path);
+  } catch (const std::exception& e) {
+    throw Failure{1, e.what()};
   }
+}
+
+int runBatch(const Options& o, const CLI::App& app) {
+  const api::ServiceConfig config = readConfig(o);
   auto [spec, base] = readSpec(o, app, config.limits);
   const api::Shard shard = readShard(o);
   const bool sharded = o.shardCount.has_value();
@@ -317,7 +322,8 @@ int batchCommand(int argc, char** argv) {
   app.add_option("--connections", o.connections,
                  "requests in flight with --server (else its workers)");
   app.add_option("--workers", o.workers, "local render workers (default: one per core)");
-  app.add_option("--config", o.config, "a limn configuration file (limits, timeout, cache)");
+  app.add_option("--config", o.config,
+                 "a limn configuration file (limits, timeout, cache; else LIMN_CONFIG)");
   app.add_option("--shard-index", o.shardIndex, "this process's shard (else JOB_COMPLETION_INDEX)");
   app.add_option("--shard-count", o.shardCount, "shards in all: rows with index % N == K");
   app.add_option("--report", o.report, "only write the report of the results in this folder");

@@ -221,6 +221,12 @@ TEST_F(BatchCli, ASpecFileSweepsAndBadInputIsNamed) {
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.output.find("no mesh file matches"), std::string::npos) << missing.output;
   EXPECT_EQ(batch("--methods coarse" + out(dir_ / "m")).status, 1);
+  // The configuration comes from --config, else LIMN_CONFIG, as for limn serve.
+  std::ofstream(dir_ / "limn.json") << R"({"wrokers": 2})";
+  CommandResult config =
+      batch(kFlags + out(dir_ / "c"), "LIMN_CONFIG='" + (dir_ / "limn.json").string() + "'");
+  EXPECT_EQ(config.status, 1);
+  EXPECT_NE(config.output.find("wrokers"), std::string::npos) << config.output;
 }
 
 }  // namespace

@@ -125,9 +125,16 @@ TEST(BatchSpec, ErrorsNameTheEntry) {
   EXPECT_EQ(fieldOf(errorOf([] { spec(R"({"methods": ["coarse"], "cameras": ["front"]})"); })),
             "meshes");
   EXPECT_EQ(fieldOf(errorOf([] {
-              spec(R"({"meshes": ["a"], "methods": ["coarse"], "cameras": ["front"], "views": 3})");
+              spec(R"({"meshes": ["a"], "methods": ["coarse"], "cameras": ["front"], "view": 3})");
             })),
-            "views");
+            "view");
+  EXPECT_EQ(
+      fieldOf(errorOf([] { spec(R"({"meshes": ["a"], "methods": ["coarse"], "views": 0})"); })),
+      "views");
+  EXPECT_EQ(fieldOf(errorOf([] {
+              spec(R"({"meshes": ["a"], "methods": ["coarse"], "cameras": ["front"], "seed": 2})");
+            })),
+            "seed");
   EXPECT_EQ(
       errorOf([] {
         spec(R"({"meshes": ["a"], "methods": ["coarse"], "cameras": ["front"], "size": 9000})");
@@ -148,6 +155,19 @@ TEST(BatchSpec, ViewsRingsAndSeededSetsExpand) {
   EXPECT_EQ(ring, (std::vector<std::string>{"az0 el20", "az90 el20", "az180 el20", "az270 el20"}));
   EXPECT_EQ(s.views[10].label, "hero");
   EXPECT_EQ(s.views[10].compareJson(64), R"({"eye":[0,0,9],"height":64,"width":64})");
+}
+
+TEST(BatchSpec, ViewsIsTheSpecsViewsFlag) {
+  // "views": N is what --views N makes, after any cameras; "seed" chooses its directions.
+  BatchSpec s = spec(R"({"meshes": ["a.obj"], "methods": ["coarse"], "views": 3})");
+  auto seeded = api::seededViews(3, 1);
+  ASSERT_EQ(s.views.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(s.views[i].cameraJson, seeded[i].cameraJson);
+  BatchSpec both = spec(
+      R"({"meshes": ["a.obj"], "methods": ["coarse"], "cameras": ["top"], "views": 2, "seed": 9})");
+  ASSERT_EQ(both.views.size(), 3u);
+  EXPECT_EQ(both.views[0].label, "top");
+  EXPECT_EQ(both.views[1].cameraJson, api::seededViews(2, 9)[0].cameraJson);
 }
 
 TEST(BatchSpec, SeededViewsAreReproducibleAndSpreadWithinTheBand) {
