@@ -278,31 +278,13 @@ ReferenceResult renderImplicitReference(const implicit::Field& field, const Came
   stats.hits = covered;
   stats.newtonFailures = unrefined;
   stats.newtonMs = msSince(start);
-  if (passes.wireframe) {
-    result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
-    if (!passes.color) result.images.passes.erase(pass::kColor);
-    result.warnings.push_back(
-        "reference wireframe: the isosurface has no edges; the pass is the shaded color");
-  }
+  colorAsWireframe(passes, "isosurface", result);
 
   if (passes.supersample > 0) {
     start = Clock::now();
     const int s = passes.supersample;
-    std::vector<char> coverage(hits.size());
-    for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
-    const Image* hint = options.maskHint;
-    if (hint && (hint->width != width * s || hint->height != height * s || hint->channels != 1)) {
-      hint = nullptr;
-    }
-    result.refinedPixels =
-        pixelsToRefine(coverage, std::vector<char>(coverage.size(), 0), width, height, hint, s);
-    size_t refined = 0;
-    for (char c : result.refinedPixels) refined += c != 0;
-    stats.refinedPixels = refined;
-    stats.raysCast += refined * s * s;
-    result.images.supersampledMask =
-        castCoverageRefined(scene.get(), camera, s, result.refinedPixels, coverage, cancel);
-    result.images.supersample = s;
+    // No outline candidates are known beforehand: mixed coverage and the hint decide.
+    castSupersampledMask(scene.get(), camera, hits, s, {}, options, cancel, result);
     stats.maskMs = msSince(start);
     if (options.locateOutline) {
       start = Clock::now();

@@ -70,39 +70,13 @@ void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
   ReferenceStats& stats = result.stats;
   stats.hits = covered;
   stats.newtonFailures = failures;
-  if (passes.wireframe) {
-    result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
-    if (!passes.color) result.images.passes.erase(pass::kColor);
-    result.warnings.push_back(
-        "reference wireframe: the limit surface has no edges; the pass is the shaded color");
-  }
+  colorAsWireframe(passes, "limit surface", result);
   if (stats.hits > 0 && stats.newtonFailures * 1000 > stats.hits) {
     result.warnings.push_back("reference: " + std::to_string(stats.newtonFailures) + " of " +
                               std::to_string(stats.hits) +
                               " hits could not be refined onto the limit surface (kept on the "
                               "dense tessellation)");
   }
-}
-
-// The supersampled mask, S x S rays only in the pixels that need them (result.refinedPixels).
-// The hint is a mask (one method's) or its blocks (several methods' merged).
-void castSupersampledMask(const ReferenceScene& built, RTCScene scene, const Camera& camera,
-                          const std::vector<PixelHit>& hits, int s, const ReferenceOptions& options,
-                          const CancelToken& cancel, ReferenceResult& result) {
-  const int width = camera.width(), height = camera.height();
-  std::vector<char> coverage(hits.size());
-  for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
-  result.refinedPixels =
-      options.hintBlocks
-          ? pixelsToRefine(coverage, built.outlineCandidates, width, height, options.hintBlocks)
-          : pixelsToRefine(coverage, built.outlineCandidates, width, height, options.maskHint, s);
-  size_t refined = 0;
-  for (char r : result.refinedPixels) refined += r != 0;
-  result.stats.refinedPixels = refined;
-  result.stats.raysCast += refined * s * s;
-  result.images.supersampledMask =
-      castCoverageRefined(scene, camera, s, result.refinedPixels, coverage, cancel);
-  result.images.supersample = s;
 }
 
 }  // namespace
@@ -155,7 +129,8 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 
   if (passes.supersample > 0) {
     start = Clock::now();
-    castSupersampledMask(*built, scene, camera, hits, passes.supersample, options, cancel, result);
+    castSupersampledMask(scene, camera, hits, passes.supersample, built->outlineCandidates, options,
+                         cancel, result);
     stats.maskMs = msSince(start);
     if (options.locateOutline) {
       start = Clock::now();

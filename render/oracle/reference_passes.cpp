@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 
 #include "render/oracle/ray_caster.h"
 #include "render/oracle/reference.h"
@@ -72,6 +73,34 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<c
   }
   const std::vector<uint8_t> blocks = maskBlocks(*hint, s);
   return pixelsToRefine(covered, std::move(refine), width, height, &blocks);
+}
+
+void castSupersampledMask(RTCScene scene, const Camera& camera, const std::vector<PixelHit>& hits,
+                          int s, std::vector<char> candidates, const ReferenceOptions& options,
+                          const CancelToken& cancel, ReferenceResult& result) {
+  const int width = camera.width(), height = camera.height();
+  std::vector<char> coverage(hits.size());
+  for (size_t p = 0; p < hits.size(); ++p) coverage[p] = hits[p].hit();
+  if (candidates.size() != coverage.size()) candidates.assign(coverage.size(), 0);
+  result.refinedPixels =
+      options.hintBlocks
+          ? pixelsToRefine(coverage, std::move(candidates), width, height, options.hintBlocks)
+          : pixelsToRefine(coverage, std::move(candidates), width, height, options.maskHint, s);
+  size_t refined = 0;
+  for (char r : result.refinedPixels) refined += r != 0;
+  result.stats.refinedPixels = refined;
+  result.stats.raysCast += refined * s * s;
+  result.images.supersampledMask =
+      castCoverageRefined(scene, camera, s, result.refinedPixels, coverage, cancel);
+  result.images.supersample = s;
+}
+
+void colorAsWireframe(const PassSelection& passes, const char* surface, ReferenceResult& result) {
+  if (!passes.wireframe) return;
+  result.images.passes[pass::kWireframe] = result.images.passes[pass::kColor];
+  if (!passes.color) result.images.passes.erase(pass::kColor);
+  result.warnings.push_back(std::string("reference wireframe: the ") + surface +
+                            " has no edges; the pass is the shaded color");
 }
 
 metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,

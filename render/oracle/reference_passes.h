@@ -13,6 +13,8 @@
 #include "render/core/shading.h"
 #include "render/metrics/outline.h"
 #include "render/oracle/embree_device.h"
+#include "render/oracle/ray_caster.h"
+#include "render/oracle/reference.h"
 #include "render/oracle/surface_hit.h"
 
 namespace limn::render::oracle {
@@ -66,6 +68,18 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<c
 // The same with the hint a mask at `s` times the size (ignored when it is not).
 std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
                                  int width, int height, const Image* hint, int s);
+
+// The supersampled mask of `scene` at S = s, S x S rays only in the pixels that need them
+// (result.refinedPixels): `candidates` (outline candidates known beforehand; may be empty),
+// pixels of mixed coverage around them in `hits`, and where options' hint (a mask or its blocks)
+// says. Fills result.images.supersampledMask, refinedPixels and the ray counts.
+void castSupersampledMask(RTCScene scene, const Camera& camera, const std::vector<PixelHit>& hits,
+                          int s, std::vector<char> candidates, const ReferenceOptions& options,
+                          const CancelToken& cancel, ReferenceResult& result);
+
+// The reference's wireframe pass when one was asked for: its colour (the exact `surface` has no
+// edges to draw), with a warning that says so; the colour pass itself stays only if asked for.
+void colorAsWireframe(const PassSelection& passes, const char* surface, ReferenceResult& result);
 
 // Coverage at image-plane points by occlusion rays into `scene`.
 metrics::CoverageQuery coverageQuery(RTCScene scene, const Camera& camera,
