@@ -153,8 +153,7 @@ int main(int argc, char** argv) {
       continue;
     }
     std::unique_ptr<subdiv::LimitSurface> refined;
-    const bool presub = !silhouette::presubdivisionReason(shape.mesh).empty() ||
-                        !silhouette::hasSimpleFaces(shape.mesh);
+    const bool presub = !silhouette::presubdivisionReason(shape.mesh).empty();
     try {
       if (presub) {
         refined = std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(shape.mesh));

@@ -13,12 +13,6 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
   if (params.presubdivide == Presubdivide::Auto) {
     refine = !silhouette::presubdivisionReason(mesh).empty();
   }
-  if (!refine && !silhouette::hasSimpleFaces(mesh)) {
-    refine = true;
-    warnings.push_back(
-        "params.presubdivide 0 overridden: the silhouette method triangulates quads "
-        "(Catmull-Clark) or triangles (Loop) only, so the mesh was refined once");
-  }
   SilhouetteBuild out;
   if (refine) {
     try {
@@ -26,15 +20,7 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
           std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh), cancel);
     } catch (const InputError& e) {
       // A safety net: if OpenSubdiv refuses the refined topology (interior valence-2 vertices
-      // that refining non-manifold meshes makes no longer are refused), draw the mesh unrefined
-      // if the method can; otherwise say why in terms of the mesh the client sent.
-      if (!silhouette::hasSimpleFaces(mesh)) {
-        throw InputError(InputError::Kind::InvalidMesh, "presubdivide",
-                         std::string("the silhouette method must refine this mesh once (it has "
-                                     "faces other than quads or triangles), and the refined "
-                                     "mesh cannot be evaluated: ") +
-                             e.what());
-      }
+      // that refining non-manifold meshes makes no longer are refused), draw the mesh unrefined.
       warnings.push_back(std::string("pre-subdivision skipped: ") + e.what());
     }
   }

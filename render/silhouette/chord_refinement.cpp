@@ -42,9 +42,10 @@ std::vector<bool> contourFaces(const subdiv::LimitSurface& surface, const Contou
   return out;
 }
 
-ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const Camera& camera,
+ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& camera,
                                     const std::vector<bool>& contourFace,
                                     const ChordOptions& options, ContourSearch& search) {
+  const subdiv::LimitSurface& surface = domains.surface();
   const Far::TopologyLevel& base = surface.baseLevel();
   const std::vector<Vec3>& limit = surface.controlLimitPositions();
   ChordRefinement out;
@@ -85,16 +86,16 @@ ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const C
       }
       if (owner < 0) continue;
       Far::ConstIndexArray ends = base.GetEdgeVertices(static_cast<int>(e));
-      Vec2 uv = edgeUV(surface, owner, static_cast<int>(e), 0.5);
-      subdiv::LimitSample mid = surface.evaluate(owner, uv.x, uv.y);
+      subdiv::LimitSample mid =
+          domains.evaluate(owner, edgeUV(domains, owner, static_cast<int>(e), 0.5));
       int segments =
           segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), mid), options);
       if (segments < 2) continue;
       out.edgeRates[e] = segments;
       for (int i = 1; i < segments; ++i) {
         double t = static_cast<double>(i) / segments;
-        Vec2 at = edgeUV(surface, owner, static_cast<int>(e), t);
-        points.push_back({t, surface.position(owner, at.x, at.y), 0u});
+        points.push_back(
+            {t, domains.position(owner, edgeUV(domains, owner, static_cast<int>(e), t)), 0u});
       }
       std::sort(points.begin(), points.end(),
                 [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
@@ -109,8 +110,8 @@ ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const C
     Far::ConstIndexArray verts = base.GetFaceVertices(f);
     for (int v : verts) centroid += limit[v];
     centroid = centroid / static_cast<double>(verts.size());
-    Vec2 c = surface.centerUV(f);
-    int rate = segmentsFor(outsidePixels(camera, centroid, surface.evaluate(f, c.x, c.y)), options);
+    int rate = segmentsFor(outsidePixels(camera, centroid, domains.evaluate(f, domains.center(f))),
+                           options);
     for (int e : base.GetFaceEdges(f)) rate = std::max(rate, out.edgeRates[e]);
     if (rate < 2) continue;
     out.interiorRates[f] = rate;

@@ -39,7 +39,7 @@ std::vector<bool> contourFaces(const subdiv::LimitSurface& surface, const Contou
 
 // Adds the uniform points to search.edgePoints (as points with no crossing) and returns the
 // rates it chose. Outline edges (which already carry uniform points) are left as they are.
-ChordRefinement refineConcaveChords(const subdiv::LimitSurface& surface, const Camera& camera,
+ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& camera,
                                     const std::vector<bool>& contourFace,
                                     const ChordOptions& options, ContourSearch& search);
 

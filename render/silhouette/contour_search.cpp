@@ -44,16 +44,16 @@ EdgeInFace locateEdge(const Far::TopologyLevel& base, int face, int edge) {
 // g along one edge as seen from one face.
 class EdgeProbe {
  public:
-  EdgeProbe(const subdiv::LimitSurface& surface, const Camera& camera, int face, int edge)
-      : surface_(surface),
+  EdgeProbe(const FaceDomains& domains, const Camera& camera, int face, int edge)
+      : domains_(domains),
         camera_(camera),
         face_(face),
-        from_(edgeUV(surface, face, edge, 0.0)),
-        to_(edgeUV(surface, face, edge, 1.0)) {}
+        from_(edgeUV(domains, face, edge, 0.0)),
+        to_(edgeUV(domains, face, edge, 1.0)) {}
 
   double g(double t) const {
-    subdiv::LimitSample s =
-        surface_.evaluate(face_, from_.x + (to_.x - from_.x) * t, from_.y + (to_.y - from_.y) * t);
+    subdiv::LimitSample s = domains_.evaluate(
+        face_, {from_.x + (to_.x - from_.x) * t, from_.y + (to_.y - from_.y) * t});
     return contourFunction(camera_, s.position, s.normal);
   }
   double slope(double t) const {
@@ -63,7 +63,7 @@ class EdgeProbe {
   }
 
  private:
-  const subdiv::LimitSurface& surface_;
+  const FaceDomains& domains_;
   const Camera& camera_;
   int face_;
   Vec2 from_, to_;
@@ -92,17 +92,14 @@ double contourFunction(const Camera& camera, const Vec3& position, const Vec3& n
   return dot(normal, camera.viewVector(position));
 }
 
-Vec2 edgeUV(const subdiv::LimitSurface& surface, int face, int edge, double t) {
-  EdgeInFace where = locateEdge(surface.baseLevel(), face, edge);
-  int n = surface.mesh().faceVertexCounts[face];
-  Vec2 a = surface.cornerUV(face, where.corner);
-  Vec2 b = surface.cornerUV(face, (where.corner + 1) % n);
-  if (!where.forward) std::swap(a, b);
-  return {a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t};
+Vec2 edgeUV(const FaceDomains& domains, int face, int edge, double t) {
+  EdgeInFace where = locateEdge(domains.surface().baseLevel(), face, edge);
+  return domains.alongEdge(face, where.corner, where.forward ? t : 1 - t);
 }
 
-ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& camera,
+ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
                             const SearchOptions& options, const CancelToken& cancel) {
+  const subdiv::LimitSurface& surface = domains.surface();
   const mesh::ControlMesh& cage = surface.mesh();
   const Far::TopologyLevel& base = surface.baseLevel();
   const std::vector<Vec3>& limitPositions = surface.controlLimitPositions();
@@ -122,8 +119,8 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
         int v = cage.faceVertexIndices[i];
         Vec3 n = limitNormals[v];
         if (surface.hasLimit(static_cast<int>(f))) {
-          Vec2 uv = surface.cornerUV(static_cast<int>(f), static_cast<int>(i - out.faceOffsets[f]));
-          Vec3 own = surface.evaluate(static_cast<int>(f), uv.x, uv.y).normal;
+          Vec2 uv = domains.corner(static_cast<int>(f), static_cast<int>(i - out.faceOffsets[f]));
+          Vec3 own = domains.evaluate(static_cast<int>(f), uv).normal;
           if (dot(own, n) < kSameNormalCos) n = own;
         }
         out.cornerNormals[i] = n;
@@ -169,7 +166,7 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
         const int face = faces[k];
         size_t c0 = cornerIndex(face, ends[0]), c1 = cornerIndex(face, ends[1]);
         double g0 = out.cornerG[c0], g1 = out.cornerG[c1];
-        EdgeProbe probe(surface, camera, face, static_cast<int>(e));
+        EdgeProbe probe(domains, camera, face, static_cast<int>(e));
         const uint32_t bits = split ? (1u << k) : allSides;
 
         bool sample = signOf(g0) != signOf(g1);
@@ -255,8 +252,7 @@ ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& c
           continue;
         }
         EdgePoint q = p;
-        Vec2 uv = edgeUV(surface, owner, static_cast<int>(e), q.t);
-        q.position = surface.position(owner, uv.x, uv.y);
+        q.position = domains.position(owner, edgeUV(domains, owner, static_cast<int>(e), q.t));
         points.push_back(q);
       }
     }

@@ -27,6 +27,7 @@
 
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
+#include "render/silhouette/face_domain.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::silhouette {
@@ -72,10 +73,10 @@ struct ContourSearch {
 // g = dot(n, viewVector(p)) for the camera.
 double contourFunction(const Camera& camera, const Vec3& position, const Vec3& normal);
 
-ContourSearch searchContour(const subdiv::LimitSurface& surface, const Camera& camera,
+ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
                             const SearchOptions& options, const CancelToken& cancel);
 
-// The parameter of base edge `edge`'s point `t` in face `face` (edge must be one of its edges).
-Vec2 edgeUV(const subdiv::LimitSurface& surface, int face, int edge, double t);
+// The point `t` of base edge `edge` in face `face`'s domain (edge must be one of its edges).
+Vec2 edgeUV(const FaceDomains& domains, int face, int edge, double t);
 
 }  // namespace limn::render::silhouette

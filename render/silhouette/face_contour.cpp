@@ -1,14 +1,11 @@
 #include "render/silhouette/face_contour.h"
 
-#include <opensubdiv/bfr/parameterization.h>
-
 #include <algorithm>
 #include <cmath>
 
 namespace limn::render::silhouette {
 
 namespace Far = OpenSubdiv::Far;
-namespace Bfr = OpenSubdiv::Bfr;
 
 namespace {
 
@@ -21,20 +18,13 @@ Vec2 lerp(const Vec2& a, const Vec2& b, double s) {
 // g = 0 along a line across the curve, in one face's parameter domain.
 class CrossLineSolver {
  public:
-  CrossLineSolver(const subdiv::LimitSurface& surface, const Camera& camera, int face)
-      : surface_(surface),
-        camera_(camera),
-        face_(face),
-        triangle_(surface.parameterization(face).GetType() == Bfr::Parameterization::TRI) {}
+  CrossLineSolver(const FaceDomains& domains, const Camera& camera, int face)
+      : domains_(domains), camera_(camera), face_(face) {}
 
-  bool inside(const Vec2& uv) const {
-    const double eps = 1e-12;
-    if (uv.x < -eps || uv.y < -eps) return false;
-    return triangle_ ? uv.x + uv.y <= 1 + eps : (uv.x <= 1 + eps && uv.y <= 1 + eps);
-  }
+  bool inside(const Vec2& uv) const { return domains_.contains(face_, uv); }
 
   double g(const Vec2& uv) const {
-    subdiv::LimitSample s = surface_.evaluate(face_, uv.x, uv.y);
+    subdiv::LimitSample s = domains_.evaluate(face_, uv);
     return contourFunction(camera_, s.position, s.normal);
   }
 
@@ -105,14 +95,13 @@ class CrossLineSolver {
   }
 
  private:
-  const subdiv::LimitSurface& surface_;
+  const FaceDomains& domains_;
   const Camera& camera_;
   int face_;
-  bool triangle_;
 };
 
 // Samples strictly between boundary points a and b.
-FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
+FaceCurve sampleCurve(const FaceDomains& domains, const Camera& camera,
                       const FaceBoundary& boundary, int from, int to, const CurveOptions& options) {
   FaceCurve curve;
   curve.from = from;
@@ -131,7 +120,7 @@ FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
     // straight line between them would run along the edge: bow it towards the face centre.
     Vec2 bow{0, 0};
     if (boundary.edge[from] == boundary.edge[to]) {
-      Vec2 c = surface.centerUV(boundary.face), mid = lerp(a.uv, b.uv, 0.5);
+      Vec2 c = domains.center(boundary.face), mid = lerp(a.uv, b.uv, 0.5);
       bow = {0.5 * (c.x - mid.x), 0.5 * (c.y - mid.y)};
     }
     Vec3 d = b.position - a.position;
@@ -148,7 +137,7 @@ FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
     return curve;
   }
 
-  CrossLineSolver solver(surface, camera, boundary.face);
+  CrossLineSolver solver(domains, camera, boundary.face);
   Vec2 along{b.uv.x - a.uv.x, b.uv.y - a.uv.y};
   double span = std::hypot(along.x, along.y);
   Vec2 across = span > 0 ? Vec2{-along.y / span, along.x / span} : Vec2{1, 0};
@@ -156,7 +145,7 @@ FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
     Vec2 origin = lerp(a.uv, b.uv, static_cast<double>(i) / (count + 1));
     Vec2 uv = origin;
     if (!solver.solve(origin, across, std::max(0.02 * span, 1e-4), &uv)) ++curve.unresolved;
-    subdiv::LimitSample s = surface.evaluate(boundary.face, uv.x, uv.y);
+    subdiv::LimitSample s = domains.evaluate(boundary.face, uv);
     curve.samples.push_back({uv, s.position, s.normal});
   }
   return curve;
@@ -164,8 +153,8 @@ FaceCurve sampleCurve(const subdiv::LimitSurface& surface, const Camera& camera,
 
 }  // namespace
 
-FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSearch& search,
-                          int face) {
+FaceBoundary faceBoundary(const FaceDomains& domains, const ContourSearch& search, int face) {
+  const subdiv::LimitSurface& surface = domains.surface();
   const Far::TopologyLevel& base = surface.baseLevel();
   Far::ConstIndexArray verts = base.GetFaceVertices(face);
   Far::ConstIndexArray edges = base.GetFaceEdges(face);
@@ -179,7 +168,7 @@ FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSear
     out.edgePoint.push_back(edgePoint);
   };
   for (int k = 0; k < verts.size(); ++k) {
-    push({surface.cornerUV(face, k), surface.controlLimitPositions()[verts[k]],
+    push({domains.corner(face, k), surface.controlLimitPositions()[verts[k]],
           search.cornerNormals[offset + k]},
          false, -1, -1);
     const int e = edges[k];
@@ -191,8 +180,8 @@ FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSear
     const bool forward = base.GetEdgeVertices(e)[0] == verts[k];
     for (size_t j = 0; j < points.size(); ++j) {
       size_t i = forward ? j : points.size() - 1 - j;
-      Vec2 uv = edgeUV(surface, face, e, points[i].t);
-      push({uv, points[i].position, surface.evaluate(face, uv.x, uv.y).normal},
+      Vec2 uv = edgeUV(domains, face, e, points[i].t);
+      push({uv, points[i].position, domains.evaluate(face, uv).normal},
            bit < 32 && (points[i].sides >> bit & 1u), e, static_cast<int>(i));
       ++out.edgePointCount;
     }
@@ -200,7 +189,7 @@ FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSear
   return out;
 }
 
-std::vector<FaceCurve> faceCurves(const subdiv::LimitSurface& surface, const Camera& camera,
+std::vector<FaceCurve> faceCurves(const FaceDomains& domains, const Camera& camera,
                                   const FaceBoundary& boundary, const CurveOptions& options,
                                   bool* oddCrossings) {
   std::vector<int> x;
@@ -212,8 +201,8 @@ std::vector<FaceCurve> faceCurves(const subdiv::LimitSurface& surface, const Cam
 
   int offset = 0;
   if (x.size() > 2) {
-    CrossLineSolver solver(surface, camera, boundary.face);
-    Vec2 c = surface.centerUV(boundary.face);
+    CrossLineSolver solver(domains, camera, boundary.face);
+    Vec2 c = domains.center(boundary.face);
     // The arc from x1 towards x2 starts with the boundary segment after x1.
     const size_t n = boundary.points.size();
     Vec2 arc = lerp(boundary.points[x[1]].uv, boundary.points[(x[1] + 1) % n].uv, 0.5);
@@ -222,7 +211,7 @@ std::vector<FaceCurve> faceCurves(const subdiv::LimitSurface& surface, const Cam
   std::vector<FaceCurve> curves;
   for (size_t i = 0; i < x.size(); i += 2) {
     int from = x[(i + offset) % x.size()], to = x[(i + offset + 1) % x.size()];
-    curves.push_back(sampleCurve(surface, camera, boundary, from, to, options));
+    curves.push_back(sampleCurve(domains, camera, boundary, from, to, options));
   }
   return curves;
 }

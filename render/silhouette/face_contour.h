@@ -25,7 +25,7 @@ namespace limn::render::silhouette {
 enum class CurveMode { PN, Exact };
 
 struct FacePoint {
-  Vec2 uv;        // in the face's parameterisation
+  Vec2 uv;        // in the face's domain (face_domain.h)
   Vec3 position;  // on the limit surface (pn curve samples excepted)
   Vec3 normal;    // the face's limit normal there
 };
@@ -54,12 +54,11 @@ struct CurveOptions {
   double pixelsPerSample = 2.0;
 };
 
-FaceBoundary faceBoundary(const subdiv::LimitSurface& surface, const ContourSearch& search,
-                          int face);
+FaceBoundary faceBoundary(const FaceDomains& domains, const ContourSearch& search, int face);
 
 // The face's crossings paired and sampled; empty when it has none. `oddCrossings` is set when
 // the count is odd (numerical trouble at a vertex): then no curve is made.
-std::vector<FaceCurve> faceCurves(const subdiv::LimitSurface& surface, const Camera& camera,
+std::vector<FaceCurve> faceCurves(const FaceDomains& domains, const Camera& camera,
                                   const FaceBoundary& boundary, const CurveOptions& options,
                                   bool* oddCrossings);
 

@@ -13,27 +13,12 @@ namespace {
 using Edge = std::pair<int, int>;
 Edge key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
 
-// True when the segment a-b runs along one side of the face's domain (the unit square, or
-// the triangle u, v >= 0, u + v <= 1): splitting it would put a point on the face's boundary
-// that the neighbour does not have.
-bool alongDomainSide(const Vec2& a, const Vec2& b, bool triangle) {
-  const double eps = 1e-9;
-  auto both = [&](auto onSide) { return onSide(a) && onSide(b); };
-  if (both([&](const Vec2& p) { return std::fabs(p.x) < eps; })) return true;
-  if (both([&](const Vec2& p) { return std::fabs(p.y) < eps; })) return true;
-  if (triangle) return both([&](const Vec2& p) { return std::fabs(p.x + p.y - 1) < eps; });
-  return both([&](const Vec2& p) { return std::fabs(p.x - 1) < eps; }) ||
-         both([&](const Vec2& p) { return std::fabs(p.y - 1) < eps; });
-}
-
 }  // namespace
 
-int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camera, int face,
+int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int face,
                         int boundaryCount, const std::vector<std::vector<int>>& lockedChains,
                         double tolerancePx, int maxSplits, std::vector<FacePoint>& points,
                         std::vector<std::array<int, 3>>& triangles) {
-  const bool triangle =
-      surface.parameterization(face).GetType() == OpenSubdiv::Bfr::Parameterization::TRI;
   std::set<Edge> locked;
   for (int i = 0; i < boundaryCount; ++i) locked.insert(key(i, (i + 1) % boundaryCount));
   for (const std::vector<int>& chain : lockedChains) {
@@ -45,7 +30,7 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
     const FacePoint& pa = points[a];
     const FacePoint& pb = points[b];
     Vec2 uv{0.5 * (pa.uv.x + pb.uv.x), 0.5 * (pa.uv.y + pb.uv.y)};
-    subdiv::LimitSample s = surface.evaluate(face, uv.x, uv.y);
+    subdiv::LimitSample s = domains.evaluate(face, uv);
     *middle = {uv, s.position, s.normal};
     Vec3 chord = 0.5 * (pa.position + pb.position);
     if (dot(chord - s.position, s.normal) <= 0) return 0.0;
@@ -88,7 +73,9 @@ int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camer
         const Vec2 &ua = points[e.first].uv, &ub = points[e.second].uv;
         if (std::hypot(ua.x - ub.x, ua.y - ub.y) < 1e-6 ||  // too short to split further
             length(points[e.first].position - points[e.second].position) < 1e-9 ||
-            alongDomainSide(ua, ub, triangle)) {
+            // along the domain's boundary: a split there would put a point on the face's
+            // boundary that the neighbour does not have
+            domains.onOneSide(face, ua, ub)) {
           checked.insert(e);
           continue;
         }

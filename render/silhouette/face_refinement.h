@@ -19,7 +19,7 @@ namespace limn::render::silhouette {
 // `points`/`triangles` as built for one face; the first `boundaryCount` points are its
 // boundary in order, and `lockedChains` lists point sequences (contour curves, endpoints
 // included) whose consecutive pairs must stay edges. Returns the number of splits made.
-int refineFaceTriangles(const subdiv::LimitSurface& surface, const Camera& camera, int face,
+int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int face,
                         int boundaryCount, const std::vector<std::vector<int>>& lockedChains,
                         double tolerancePx, int maxSplits, std::vector<FacePoint>& points,
                         std::vector<std::array<int, 3>>& triangles);

@@ -12,35 +12,8 @@ namespace limn::render::silhouette {
 
 namespace Far = OpenSubdiv::Far;
 
-namespace {}  // namespace
-
-bool hasSimpleFaces(const mesh::ControlMesh& mesh) {
-  int want = mesh.scheme == mesh::Scheme::Loop ? 3 : 4;
-  for (int n : mesh.faceVertexCounts) {
-    if (n != want) return false;
-  }
-  return true;
-}
-
 std::string presubdivisionReason(const mesh::ControlMesh& mesh) {
   if (mesh.faceCount() < kAutoFaceLimit) return "it has fewer than 500 faces";
-  if (!hasSimpleFaces(mesh)) {
-    return mesh.scheme == mesh::Scheme::Loop ? "it has non-triangle faces"
-                                             : "it has non-quad faces";
-  }
-  // Regular valence is 4 for Catmull-Clark and 6 for Loop.
-  const int regular = mesh.scheme == mesh::Scheme::Loop ? 6 : 4;
-  subdiv::LimitSurface probe(mesh);
-  const Far::TopologyLevel& level = probe.baseLevel();
-  auto extraordinary = [&](int v) {
-    return !level.IsVertexBoundary(v) && level.GetVertexEdges(v).size() != regular;
-  };
-  for (int e = 0; e < level.GetNumEdges(); ++e) {
-    Far::ConstIndexArray ends = level.GetEdgeVertices(e);
-    if (extraordinary(ends[0]) && extraordinary(ends[1])) {
-      return "edge " + std::to_string(e) + " joins two extraordinary vertices";
-    }
-  }
   return {};
 }
 

@@ -27,12 +27,15 @@ struct FacePiece {
 
 // A ring face refined by refineConcaveChords: Bfr's tessellation with the face's edge rates
 // and an inner rate. Its boundary points are exactly the face's (corner 0, the points of edge
-// 0, corner 1, ...) when every edge carries only its uniform points; false otherwise.
-bool tessellateRingFace(const subdiv::LimitSurface& surface, const ContourSearch& search,
+// 0, corner 1, ...) when every edge carries only its uniform points; false otherwise, and for
+// faces whose domain is not Bfr's (face_domain.h).
+bool tessellateRingFace(const FaceDomains& domains, const ContourSearch& search,
                         const ChordRefinement& chords, const FaceBoundary& boundary,
                         FacePiece& piece) {
   namespace Bfr = OpenSubdiv::Bfr;
+  const subdiv::LimitSurface& surface = domains.surface();
   const int face = boundary.face;
+  if (surface.parameterization(face).HasSubFaces()) return false;
   OpenSubdiv::Far::ConstIndexArray edges = surface.baseLevel().GetFaceEdges(face);
   std::vector<int> rates;
   for (int e : edges) {
@@ -58,17 +61,17 @@ bool tessellateRingFace(const subdiv::LimitSurface& surface, const ContourSearch
   return true;
 }
 
-FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
-                    const ContourSearch& search, const ChordRefinement& chords,
-                    const SilhouetteOptions& options, int face) {
+FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const ContourSearch& search,
+                    const ChordRefinement& chords, const SilhouetteOptions& options, int face) {
+  const subdiv::LimitSurface& surface = domains.surface();
   FacePiece piece;
-  FaceBoundary boundary = faceBoundary(surface, search, face);
+  FaceBoundary boundary = faceBoundary(domains, search, face);
   const int corners = static_cast<int>(boundary.points.size()) - boundary.edgePointCount;
   piece.coarseTriangles = static_cast<size_t>(corners - 2);
   piece.points = boundary.points;
   if (chords.interiorRates[face] >= 2) {
     piece.corrected = true;
-    if (tessellateRingFace(surface, search, chords, boundary, piece)) return piece;
+    if (tessellateRingFace(domains, search, chords, boundary, piece)) return piece;
     piece.points = boundary.points;  // fall back to clipping the boundary alone
   }
   if (boundary.edgePointCount == 0) {
@@ -76,7 +79,7 @@ FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
     return piece;
   }
   piece.corrected = true;
-  std::vector<FaceCurve> curves = faceCurves(surface, camera, boundary, options.curves, &piece.odd);
+  std::vector<FaceCurve> curves = faceCurves(domains, camera, boundary, options.curves, &piece.odd);
   std::vector<CurvePath> paths;
   for (FaceCurve& curve : curves) {
     CurvePath path{curve.from, curve.to, {}};
@@ -120,7 +123,7 @@ FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
       chains.push_back(std::move(chain));
     }
     piece.splits = refineFaceTriangles(
-        surface, camera, face, static_cast<int>(boundary.points.size()), chains,
+        domains, camera, face, static_cast<int>(boundary.points.size()), chains,
         options.chords.tolerancePx, options.chords.maxFaceSplits, piece.points, piece.triangles);
   }
   return piece;
@@ -131,10 +134,11 @@ FacePiece buildFace(const subdiv::LimitSurface& surface, const Camera& camera,
 SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Camera& camera,
                                    const SilhouetteOptions& options, const CancelToken& cancel) {
   SilhouetteMesh out;
-  out.search = searchContour(surface, camera, options.search, cancel);
+  const FaceDomains domains(surface);
+  out.search = searchContour(domains, camera, options.search, cancel);
   out.stats.search = out.search.stats;
   const ChordRefinement chords = refineConcaveChords(
-      surface, camera, contourFaces(surface, out.search), options.chords, out.search);
+      domains, camera, contourFaces(surface, out.search), options.chords, out.search);
   out.stats.refinedEdges = chords.refinedEdges;
   out.stats.refinedFaces = chords.refinedFaces;
 
@@ -144,7 +148,7 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
     for (size_t f = begin; f < end; ++f) {
       if ((f & 63) == 0) cancel.check();
       if (!surface.hasLimit(static_cast<int>(f))) continue;
-      pieces[f] = buildFace(surface, camera, out.search, chords, options, static_cast<int>(f));
+      pieces[f] = buildFace(domains, camera, out.search, chords, options, static_cast<int>(f));
     }
   });
   cancel.check();
@@ -171,10 +175,13 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
       mesh.normals.emplace_back(p.normal);
       mesh.limitPositions.emplace_back(p.position);
     }
+    // (u, v) leave the method in Bfr's parameterisation, as every other mesh has them.
+    std::vector<Vec2> surfaceUVs;
+    for (const FacePoint& p : piece.points) surfaceUVs.push_back(domains.toSurface(f, p.uv));
     for (const std::array<int, 3>& t : piece.triangles) {
       for (int k : t) {
         mesh.indices.push_back(first + static_cast<uint32_t>(k));
-        const Vec2& uv = piece.points[k].uv;
+        const Vec2& uv = surfaceUVs[k];
         mesh.cornerUVs.push_back({static_cast<float>(uv.x), static_cast<float>(uv.y)});
       }
       mesh.triangleFaces.push_back(f);
@@ -191,7 +198,10 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
     out.stats.interiorSplits += piece.splits;
     out.stats.unresolvedSamples += piece.unresolved;
     if (piece.odd) ++out.stats.oddFaces;
-    for (ContourCurve& c : piece.curves) out.curves.push_back(std::move(c));
+    for (ContourCurve& c : piece.curves) {
+      for (FacePoint& p : c.points) p.uv = domains.toSurface(f, p.uv);
+      out.curves.push_back(std::move(c));
+    }
   }
   out.stats.trianglesDrawn = mesh.triangleCount();
   return out;

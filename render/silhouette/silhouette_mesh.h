@@ -34,7 +34,7 @@ struct ContourCurve {
   int face = -1;
   int fromEdge = -1, fromPoint = -1;  // ContourSearch::edgePoints[fromEdge][fromPoint]
   int toEdge = -1, toPoint = -1;
-  std::vector<FacePoint> points;
+  std::vector<FacePoint> points;  // (u, v) in Bfr's parameterisation of the face
 };
 
 struct SilhouetteStats {

@@ -55,6 +55,55 @@ CameraSpec obliqueView() {
   return spec;
 }
 
+// A Catmull-Clark n-gon's domain is a regular polygon mapped onto Bfr's sub-faces: its corners
+// and edges land where Bfr puts them, and the map is continuous across the kites' borders (no
+// seam inside the face for the contour curves or the triangulation to fall into).
+TEST(FaceDomains, PolygonDomainsMatchBfrAndAreContinuous) {
+  ControlMesh m;
+  m.points = {{0, 0, 0},      {1, 0, 0.2},     {1.4, 0.9, 0}, {0.5, 1.5, 0.3},
+              {-0.4, 0.9, 0}, {2.4, 0.2, 0.1}, {0.5, -1.0, 0}};
+  testing::addFace(m, {0, 1, 2, 3, 4});  // a pentagon
+  testing::addFace(m, {1, 5, 2});        // a triangle
+  testing::addFace(m, {0, 6, 1});
+  subdiv::LimitSurface surface(m);
+  FaceDomains domains(surface);
+  const double scale = surface.bounds().diagonal();
+  for (int face = 0; face < 3; ++face) {
+    const int n = domains.size(face);
+    const auto param = surface.parameterization(face);
+    for (int k = 0; k < n; ++k) {
+      for (double t : {0.0, 0.25, 0.5, 0.75}) {
+        double bfr[2];
+        param.GetEdgeCoord(k, t, bfr);
+        Vec3 expected = surface.position(face, bfr[0], bfr[1]);
+        EXPECT_LT(length(domains.position(face, domains.alongEdge(face, k, t)) - expected),
+                  1e-9 * scale)
+            << "face " << face << " edge " << k << " t " << t;
+      }
+    }
+    Vec2 c = domains.center(face);
+    double bfrCenter[2];
+    param.GetCenterCoord(bfrCenter);
+    EXPECT_LT(
+        length(domains.position(face, c) - surface.position(face, bfrCenter[0], bfrCenter[1])),
+        1e-9 * scale);
+    // Walk circles about the centre (inside the polygon's incircle, radius cos(pi / n) / 2):
+    // neighbouring points stay neighbours on the surface.
+    for (double fraction : {0.2, 0.6, 0.99}) {
+      const double r = fraction * 0.5 * std::cos(M_PI / n);
+      Vec3 last = domains.position(face, {c.x + r, c.y});
+      for (int i = 1; i <= 2000; ++i) {
+        double a = 2 * M_PI * i / 2000;
+        Vec2 uv{c.x + r * std::cos(a), c.y + r * std::sin(a)};
+        ASSERT_TRUE(domains.contains(face, uv));
+        Vec3 p = domains.position(face, uv);
+        EXPECT_LT(length(p - last), 0.01 * scale) << "face " << face << " r " << r << " a " << a;
+        last = p;
+      }
+    }
+  }
+}
+
 TEST(ContourSearch, FindsBothCrossingsOfAnEdgeWhoseEndsAgree) {
   subdiv::LimitSurface surface(ridge());
   Camera camera = sideView(0.58);
@@ -62,7 +111,7 @@ TEST(ContourSearch, FindsBothCrossingsOfAnEdgeWhoseEndsAgree) {
   for (int samples : {1, 4}) {
     SearchOptions options;
     options.edgeSamples = samples;  // 1: only the slope test can see the pair
-    ContourSearch search = searchContour(surface, camera, options, CancelToken());
+    ContourSearch search = searchContour(FaceDomains(surface), camera, options, CancelToken());
     int doubled = 0;
     for (int e = 0; e < base.GetNumEdges(); ++e) {
       auto ends = base.GetEdgeVertices(e);
@@ -75,8 +124,9 @@ TEST(ContourSearch, FindsBothCrossingsOfAnEdgeWhoseEndsAgree) {
         if (p.sides == 0) continue;  // a point shaping a boundary edge, not a crossing
         ++crossings;
         // On the contour: the limit normal there is perpendicular to the view.
-        Vec2 uv = edgeUV(surface, base.GetEdgeFaces(e)[0], e, p.t);
-        subdiv::LimitSample s = surface.evaluate(base.GetEdgeFaces(e)[0], uv.x, uv.y);
+        FaceDomains domains(surface);
+        Vec2 uv = edgeUV(domains, base.GetEdgeFaces(e)[0], e, p.t);
+        subdiv::LimitSample s = domains.evaluate(base.GetEdgeFaces(e)[0], uv);
         EXPECT_LT(std::fabs(dot(s.normal, camera.forward())), 0.02);
       }
       EXPECT_EQ(crossings, 2) << "edge " << e << " with " << samples << " samples";

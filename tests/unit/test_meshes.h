@@ -1,6 +1,7 @@
 // Small control meshes made by code, shared by unit tests and benchmarks.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <numbers>
@@ -201,6 +202,110 @@ inline ControlMesh pawn(int around = 28) {
       addFace(m, {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
   }
   for (int k = 0; k < around; ++k) addFace(m, {id(rings, k), id(rings, k + 1), top});
+  return m;
+}
+
+// Creases on every edge of `m` (sharpness per edge from `sharpness(edge index)`), for the
+// sharp-feature meshes below. Edges are listed once, in the order faces first use them.
+template <class Sharpness>
+inline ControlMesh withEveryEdgeCreased(ControlMesh m, Sharpness sharpness) {
+  std::vector<std::pair<int, int>> seen;
+  size_t offset = 0;
+  for (int count : m.faceVertexCounts) {
+    for (int k = 0; k < count; ++k) {
+      int a = m.faceVertexIndices[offset + k], b = m.faceVertexIndices[offset + (k + 1) % count];
+      std::pair<int, int> key{std::min(a, b), std::max(a, b)};
+      bool known = false;
+      for (const auto& e : seen) known = known || e == key;
+      if (known) continue;
+      seen.push_back(key);
+      m.creases.push_back({a, b, sharpness(static_cast<int>(seen.size()) - 1)});
+    }
+    offset += count;
+  }
+  return m;
+}
+
+// The project's sharp-feature meshes (issue 10): a cube whose edges and corners are all
+// infinitely sharp (its limit surface is the cube itself, every contour an outline along sharp
+// edges), one with only its corners infinitely sharp (smooth faces meeting in eight points), a
+// semi-sharp cube (sharpness 1 to 3 by edge) and the same with Chaikin's crease rule, and Loop's
+// tetrahedron with infinitely sharp edges.
+inline ControlMesh sharpCube(Scheme scheme = Scheme::CatmullClark) {
+  ControlMesh m =
+      withEveryEdgeCreased(cube(scheme), [](int) { return render::mesh::kInfiniteSharpness; });
+  for (int v = 0; v < 8; ++v) m.corners.push_back({v, render::mesh::kInfiniteSharpness});
+  return m;
+}
+inline ControlMesh cubeWithSharpCorners(Scheme scheme = Scheme::CatmullClark) {
+  ControlMesh m = cube(scheme);
+  for (int v = 0; v < 8; ++v) m.corners.push_back({v, render::mesh::kInfiniteSharpness});
+  return m;
+}
+inline ControlMesh semiSharpCube(bool chaikin = false) {
+  ControlMesh m = withEveryEdgeCreased(cube(), [](int e) { return 1.0f + (e % 3); });
+  if (chaikin) m.creaseMethod = render::mesh::CreaseMethod::Chaikin;
+  return m;
+}
+inline ControlMesh sharpTetrahedron() {
+  return withEveryEdgeCreased(
+      tetrahedron(), [](int e) { return e % 2 == 0 ? render::mesh::kInfiniteSharpness : 2.0f; });
+}
+
+// A dense torus for the triangle-share measurements (issue 10): `ring` x `tube` quads
+// (48 x 24 = 1,152) with every vertex pushed along its normal by a few smooth waves, so the
+// contour wanders over the faces rather than following the grid.
+inline ControlMesh wavyTorus(int ring = 48, int tube = 24) {
+  ControlMesh m = torus(ring, tube, false);
+  const double R = 1.0;
+  for (int i = 0; i < ring; ++i) {
+    double a = 2 * std::numbers::pi * i / ring;
+    for (int j = 0; j < tube; ++j) {
+      double b = 2 * std::numbers::pi * j / tube;
+      Vec3& p = m.points[i * tube + j];
+      Vec3 centre{R * std::cos(a), R * std::sin(a), 0};
+      Vec3 out = p - centre;
+      double wave = 1.0 + 0.18 * std::sin(5 * a + 2 * b) + 0.08 * std::cos(9 * a - b);
+      p = centre + out * wave;
+    }
+  }
+  return m;
+}
+
+// An icosphere: the icosahedron with every triangle split into four `levels` times, the new
+// points pushed onto the unit sphere and then out by a few smooth bumps. 20 * 4^levels
+// triangles (3: 1,280). As a Catmull-Clark mesh every face is a triangle (no quad at all) and
+// every vertex extraordinary: the hardest dense input for methods that want quads.
+inline ControlMesh icosphere(int levels = 3, Scheme scheme = Scheme::CatmullClark) {
+  ControlMesh m = icosahedron(scheme);
+  for (Vec3& p : m.points) p = p * (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z));
+  for (int level = 0; level < levels; ++level) {
+    std::vector<std::pair<std::pair<int, int>, int>> midpoints;
+    auto midpoint = [&](int a, int b) {
+      std::pair<int, int> key{std::min(a, b), std::max(a, b)};
+      for (const auto& [k, v] : midpoints) {
+        if (k == key) return v;
+      }
+      Vec3 p = (m.points[a] + m.points[b]) * 0.5;
+      m.points.push_back(p * (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)));
+      midpoints.push_back({key, static_cast<int>(m.points.size()) - 1});
+      return midpoints.back().second;
+    };
+    std::vector<int> old = m.faceVertexIndices;
+    m.faceVertexIndices.clear();
+    m.faceVertexCounts.clear();
+    for (size_t i = 0; i < old.size(); i += 3) {
+      int a = old[i], b = old[i + 1], c = old[i + 2];
+      int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+      addFace(m, {a, ab, ca});
+      addFace(m, {ab, b, bc});
+      addFace(m, {ca, bc, c});
+      addFace(m, {ab, bc, ca});
+    }
+  }
+  for (Vec3& p : m.points) {
+    p = p * (1.0 + 0.15 * std::sin(4 * p.x + 1) * std::cos(3 * p.y) + 0.07 * std::sin(6 * p.z));
+  }
   return m;
 }
 
