@@ -130,6 +130,7 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
     w.Key(key);
     w.Uint64(value);
   };
+  count("presubdivisionLevels", static_cast<size_t>(s.presubdivisionLevels));
   count("edgesTested", s.search.edgesTested);
   count("edgesWithSignChange", s.search.edgesWithSignChange);
   count("edgesSampled", s.search.edgesSampled);

@@ -10,9 +10,13 @@
 //   - the worst views, each with the camera JSON that reproduces it through /v1/render.
 //
 //   silhouette_views_bench [--size 1024] [--views 8] [--seed 1] [--max-level 5] [--worst 20]
-//                          [--shapes a,b,...]
+//                          [--presubdivide auto|never|once] [--shapes a,b,...] [--dump DIR]
+// --dump writes each of the worst views as a /v1/render request body (method silhouette, the
+// reference, colour, diff and contours) to DIR/<shape>-view<k>.json, for `limn render`.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -36,6 +40,7 @@ struct Options {
   uint64_t seed = 1;
   silhouette::Presubdivide presubdivide = silhouette::Presubdivide::Auto;
   std::vector<std::string> shapes;
+  std::string dump;
 };
 
 Options parse(int argc, char** argv) {
@@ -47,6 +52,7 @@ Options parse(int argc, char** argv) {
     if (flag == "--seed") o.seed = std::stoull(value);
     if (flag == "--max-level") o.maxLevel = std::stoi(value);
     if (flag == "--worst") o.worst = std::stoi(value);
+    if (flag == "--dump") o.dump = value;
     if (flag == "--presubdivide") {
       o.presubdivide = value == "never"  ? silhouette::Presubdivide::Never
                        : value == "once" ? silhouette::Presubdivide::Once
@@ -62,6 +68,7 @@ Options parse(int argc, char** argv) {
 
 // One (shape, view) pair.
 struct ViewResult {
+  const testing::NamedMesh* mesh = nullptr;
   std::string shape, shapeClass;
   int view = 0;
   std::string camera;
@@ -90,9 +97,8 @@ std::vector<ViewResult> measureShape(const testing::NamedMesh& shape, const Opti
   pipeline::CompareJob job;
   job.mesh = shape.mesh;
   subdiv::LimitSurface surface(shape.mesh);
-  std::vector<testing::RandomView> views =
-      testing::randomViews(surface.bounds(), options.views,
-                            testing::viewSeed(options.seed, shape.name), options.size);
+  std::vector<testing::RandomView> views = testing::randomViews(
+      surface.bounds(), options.views, testing::viewSeed(options.seed, shape.name), options.size);
   for (const auto& view : views) job.cameras.push_back(view.camera);
   pipeline::MethodParams silhouetteParams;
   silhouetteParams.presubdivide = options.presubdivide;
@@ -111,6 +117,7 @@ std::vector<ViewResult> measureShape(const testing::NamedMesh& shape, const Opti
   const size_t methods = job.methods.size();
   for (size_t c = 0; c < job.cameras.size(); ++c) {
     ViewResult v;
+    v.mesh = &shape;
     v.shape = shape.name;
     v.shapeClass = kind;
     v.view = static_cast<int>(c);
@@ -170,16 +177,17 @@ void printShapeTable(const std::vector<ViewResult>& all) {
         time.push_back(v->ms / v->uniformMs);
       }
     }
-    std::string shareText = share.empty() ? "none as accurate"
-                                          : std::to_string(static_cast<int>(
-                                                100 * quantile(share, 0.5) + 0.5)) + "%";
-    std::string timeText = time.empty() ? "-" : std::to_string(quantile(time, 0.5)).substr(0, 4) + "x";
-    std::printf("| %s | %s | %zu%s | %.3f | %.3f | %.3f (%d) | %d/%zu | %.0f | %s (%zu views) | %s |\n",
-                name.c_str(), views[0]->shapeClass.c_str(), views.size(),
-                failed ? (" (" + std::to_string(failed) + " failed)").c_str() : "",
-                quantile(px, 0.5), quantile(px, 0.95), worst ? worst->px : -1,
-                worst ? worst->view : -1, within, px.size(), quantile(tris, 0.5),
-                shareText.c_str(), share.size(), timeText.c_str());
+    std::string shareText =
+        share.empty() ? "none as accurate"
+                      : std::to_string(static_cast<int>(100 * quantile(share, 0.5) + 0.5)) + "%";
+    std::string timeText =
+        time.empty() ? "-" : std::to_string(quantile(time, 0.5)).substr(0, 4) + "x";
+    std::printf(
+        "| %s | %s | %zu%s | %.3f | %.3f | %.3f (%d) | %d/%zu | %.0f | %s (%zu views) | %s |\n",
+        name.c_str(), views[0]->shapeClass.c_str(), views.size(),
+        failed ? (" (" + std::to_string(failed) + " failed)").c_str() : "", quantile(px, 0.5),
+        quantile(px, 0.95), worst ? worst->px : -1, worst ? worst->view : -1, within, px.size(),
+        quantile(tris, 0.5), shareText.c_str(), share.size(), timeText.c_str());
   }
   std::printf("\n");
 }
@@ -213,14 +221,41 @@ void printClassTable(const std::vector<ViewResult>& all) {
   std::printf("\n");
 }
 
-void printWorst(std::vector<ViewResult> all, int count) {
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '\n') {
+      out += "\\n";
+    } else {
+      if (c == '"' || c == '\\') out += '\\';
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+void dumpRequest(const ViewResult& v, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream out(dir + "/" + v.shape + "-view" + std::to_string(v.view) + ".json");
+  out << "{\"mesh\": {\"format\": \"obj\", \"scheme\": \""
+      << testing::schemeName(v.mesh->mesh.scheme)
+      << "\", \"data\": " << jsonString(testing::controlMeshObj(v.mesh->mesh))
+      << "},\n \"camera\": " << v.camera
+      << ",\n \"method\": \"silhouette\", \"reference\": true,"
+         " \"outputs\": [\"color\", \"diff\", \"contours\"]}\n";
+}
+
+void printWorst(std::vector<ViewResult> all, int count, const std::string& dump) {
   std::sort(all.begin(), all.end(), [](const ViewResult& a, const ViewResult& b) {
     if (a.error.has_value() != b.error.has_value()) return a.error.has_value();
     return a.px > b.px;
   });
-  std::printf("| shape | view | hausdorffPx | outline px | PSNR | camera |\n|---|---:|---:|---:|---:|---|\n");
+  std::printf(
+      "| shape | view | hausdorffPx | outline px | PSNR | camera "
+      "|\n|---|---:|---:|---:|---:|---|\n");
   for (int i = 0; i < count && i < static_cast<int>(all.size()); ++i) {
     const ViewResult& v = all[i];
+    if (!dump.empty()) dumpRequest(v, dump);
     if (v.error) {
       std::printf("| %s | %d | failed: %s | - | - | `%s` |\n", v.shape.c_str(), v.view,
                   v.error->c_str(), v.camera.c_str());
@@ -266,6 +301,6 @@ int main(int argc, char** argv) {
   std::printf("## By shape\n\n");
   printShapeTable(all);
   std::printf("## The worst views\n\n");
-  printWorst(all, options.worst);
+  printWorst(all, options.worst, options.dump);
   return 0;
 }

@@ -18,10 +18,24 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
     try {
       out.presubdivided =
           std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh), cancel);
+      out.presubdivisionLevels = 1;
+      while (params.presubdivide == Presubdivide::Auto &&
+             out.presubdivisionLevels < silhouette::kMaxPresubdivisionLevels &&
+             out.presubdivided->faceCount() < silhouette::kAutoFaceLimit &&
+             silhouette::chordDeviationPx(*out.presubdivided, camera) >
+                 silhouette::kMaxChordDeviationPx) {
+        out.presubdivided = std::make_unique<subdiv::LimitSurface>(
+            silhouette::refineOnce(out.presubdivided->mesh()), cancel);
+        ++out.presubdivisionLevels;
+      }
     } catch (const InputError& e) {
       // A safety net: if OpenSubdiv refuses the refined topology (interior valence-2 vertices
       // that refining non-manifold meshes makes no longer are refused), draw the mesh unrefined.
-      warnings.push_back(std::string("pre-subdivision skipped: ") + e.what());
+      warnings.push_back((out.presubdivisionLevels == 0
+                              ? std::string("pre-subdivision skipped: ")
+                              : "pre-subdivision stopped after " +
+                                    std::to_string(out.presubdivisionLevels) + " levels: ") +
+                         e.what());
     }
   }
 
@@ -32,6 +46,7 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
   options.curves.mode = params.contour;
   options.maxTriangles = maxTriangles;
   out.built = silhouette::buildSilhouetteMesh(out.drawn(surface), camera, options, cancel);
+  out.built.stats.presubdivisionLevels = out.presubdivisionLevels;
 
   const silhouette::SilhouetteStats& stats = out.built.stats;
   if (stats.oddFaces > 0) {

@@ -28,6 +28,7 @@ struct SilhouetteBuild {
   // The mesh refined once, when it was (same limit surface, finer cage); the curves' faces
   // and (u, v) refer to it. Null when the method ran on the request's surface.
   std::unique_ptr<subdiv::LimitSurface> presubdivided;
+  int presubdivisionLevels = 0;  // refinement steps that made it
   silhouette::SilhouetteMesh built;
 
   // The surface the curves were found on.
@@ -36,9 +37,9 @@ struct SilhouetteBuild {
   }
 };
 
-// Refines `surface`'s mesh once under "auto" when presubdivisionReason() gives a reason, under
-// 1 always, and under 0 only when its faces are not all quads or all triangles (with a warning
-// saying so); then builds the silhouette mesh. Appends the warnings for faces with an odd
+// Refines `surface`'s mesh under "auto" when presubdivisionReason() gives a reason (once, then
+// again while chordDeviationPx() is over kMaxChordDeviationPx: presubdivide.h), once under 1
+// and never under 0; then builds the silhouette mesh. Appends the warnings for faces with an odd
 // crossing count and for exact samples that found no root.
 SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camera& camera,
                                 const SilhouetteParams& params, size_t maxTriangles,

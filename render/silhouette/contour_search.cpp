@@ -137,6 +137,15 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
     return out.faceOffsets[face];
   };
 
+  auto endNormalsDisagree = [&](Far::ConstIndexArray faces, Far::ConstIndexArray ends) {
+    for (int end : {ends[0], ends[1]}) {
+      const Vec3& a = out.cornerNormals[cornerIndex(faces[0], end)];
+      const Vec3& b = out.cornerNormals[cornerIndex(faces[1], end)];
+      if (dot(a, b) < kSameNormalCos) return true;
+    }
+    return false;
+  };
+
   std::atomic<size_t> tested{0}, signChanges{0}, sampled{0}, doubles{0}, outlines{0};
   out.edgePoints.resize(base.GetNumEdges());
   parallelFor(base.GetNumEdges(), 64, [&](size_t begin, size_t end) {
@@ -154,9 +163,13 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
       }
       if (validFaces == 0) continue;
       ++tested;
-      const bool split = validFaces > 2 ||
-                         (validFaces == 2 &&
-                          base.GetEdgeSharpness(static_cast<int>(e)) >= mesh::kInfiniteSharpness);
+      const bool crease = validFaces > 2 ||
+                          (validFaces == 2 &&
+                           base.GetEdgeSharpness(static_cast<int>(e)) >= mesh::kInfiniteSharpness);
+      // Faces that disagree on the normal at an end (an infinitely sharp corner, a dart, a
+      // valence-2 vertex) see g jump there: each face's crossings must come from its own g,
+      // or the count around a face comes out odd and its contour is lost.
+      const bool split = crease || (validFaces == 2 && endNormalsDisagree(faces, ends));
 
       found.clear();
       bool signChange = false, wasSampled = false, sideSignsDiffer = false;
@@ -222,7 +235,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
         if (!split) break;  // one face sees the whole edge
       }
       // Outline edges: shaped along their limit curve wherever they could show.
-      const bool outline = validFaces == 1 || (split && (sideSignsDiffer || !found.empty()));
+      const bool outline = validFaces == 1 || (crease && (sideSignsDiffer || !found.empty()));
       if (outline) {
         ++outlines;
         const Vec3 a = camera.project(limitPositions[ends[0]]);

@@ -16,7 +16,9 @@
 //
 // Each crossing is bracketed, narrowed by `searchSteps` bisections and placed by linear
 // interpolation in the last interval. Infinitely sharp interior edges carry two normals (one
-// per face), so they are searched once per face; every other edge once. Boundary edges and
+// per face), and so do edges whose faces disagree on the normal at an end (infinitely sharp
+// corners, darts, valence-2 vertices): they are searched once per face; every other edge
+// once. Boundary edges and
 // sharp edges whose faces disagree on facing are outline, and get points along their limit
 // curve as well (see SearchOptions). The points of an edge
 // are shared by all its faces, so the re-triangulated faces keep their shared edges identical.

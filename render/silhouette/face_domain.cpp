@@ -32,7 +32,8 @@ Vec2 invertBilinear(const Vec2& c, const Vec2& m1, const Vec2& o, const Vec2& m0
   const Vec2 q{o.x - m1.x - m0.x + c.x, o.y - m1.y - m0.y + c.y};
   double s = 0.5, t = 0.5;
   for (int it = 0; it < 20; ++it) {
-    Vec2 f{c.x + s * e1.x + t * e0.x + s * t * q.x - p.x, c.y + s * e1.y + t * e0.y + s * t * q.y - p.y};
+    Vec2 f{c.x + s * e1.x + t * e0.x + s * t * q.x - p.x,
+           c.y + s * e1.y + t * e0.y + s * t * q.y - p.y};
     Vec2 ds{e1.x + t * q.x, e1.y + t * q.y}, dt{e0.x + s * q.x, e0.y + s * q.y};
     double det = cross2(ds, dt);
     if (det == 0) break;
@@ -54,7 +55,7 @@ FaceDomains::FaceDomains(const subdiv::LimitSurface& surface) : surface_(surface
     sizes_[f] = surface.mesh().faceVertexCounts[f];
     if (!surface.hasLimit(f)) continue;
     Bfr::Parameterization param = surface.parameterization(f);
-    kind_[f] = param.HasSubFaces() ? Kind::Polygon
+    kind_[f] = param.HasSubFaces()                             ? Kind::Polygon
                : param.GetType() == Bfr::Parameterization::TRI ? Kind::Triangle
                                                                : Kind::Quad;
   }

@@ -17,6 +17,35 @@ std::string presubdivisionReason(const mesh::ControlMesh& mesh) {
   return {};
 }
 
+double chordDeviationPx(const subdiv::LimitSurface& surface, const Camera& camera) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  const std::vector<Vec3>& limit = surface.controlLimitPositions();
+  auto pixels = [&](const Vec3& flat, const Vec3& onSurface) {
+    const double depth = camera.depthOf(onSurface);
+    if (depth <= camera.nearPlane()) return 0.0;  // behind the eye or clipped away
+    return length(flat - onSurface) * camera.pixelsPerUnit(depth);
+  };
+  double worst = 0;
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!surface.hasLimit(f)) continue;
+    Far::ConstIndexArray verts = base.GetFaceVertices(f);
+    const int n = verts.size();
+    const auto param = surface.parameterization(f);
+    Vec3 mean{0, 0, 0};
+    for (int v : verts) mean += limit[v];
+    mean = mean / static_cast<double>(n);
+    double uv[2];
+    param.GetCenterCoord(uv);
+    worst = std::max(worst, pixels(mean, surface.position(f, uv[0], uv[1])));
+    for (int k = 0; k < n; ++k) {
+      param.GetEdgeCoord(k, 0.5, uv);
+      Vec3 chord = (limit[verts[k]] + limit[verts[(k + 1) % n]]) * 0.5;
+      worst = std::max(worst, pixels(chord, surface.position(f, uv[0], uv[1])));
+    }
+  }
+  return worst;
+}
+
 mesh::ControlMesh refineOnce(const mesh::ControlMesh& mesh) {
   subdiv::LimitSurface probe(mesh);
   std::unique_ptr<Far::TopologyRefiner> refiner = probe.createRefiner();

@@ -8,7 +8,9 @@
 
 #include <string>
 
+#include "render/core/camera.h"
 #include "render/mesh/control_mesh.h"
+#include "render/subdiv/limit_surface.h"
 
 namespace limn::render::silhouette {
 
@@ -23,6 +25,19 @@ inline constexpr int kAutoFaceLimit = 500;
 
 // The reason `mesh` should be refined once under "auto", or empty when it need not be.
 std::string presubdivisionReason(const mesh::ControlMesh& mesh);
+
+// Once refined, "auto" refines again (at most kMaxPresubdivisionLevels in all, and only while
+// the refined mesh stays under 4 x kAutoFaceLimit faces) while the flat faces are further than
+// kMaxChordDeviationPx from the limit surface: a coarse cage of a spiky or strongly curved shape
+// (a cube with infinitely sharp corners) leaves chords so far outside the surface that the
+// per-face corrections cannot bring them in.
+inline constexpr int kMaxPresubdivisionLevels = 3;
+inline constexpr double kMaxChordDeviationPx = 4.0;
+
+// The largest distance, in pixels of `camera` at its depth, between a face's flat piece (its
+// corners' limit points, joined bilinearly for quads and linearly for triangles; their mean for
+// other faces) and the limit surface, over every face's centre and edge midpoints in view.
+double chordDeviationPx(const subdiv::LimitSurface& surface, const Camera& camera);
 
 // The mesh after one uniform OpenSubdiv refinement step: positions interpolated, edge and
 // vertex sharpness and holes carried over from Far's refined level.

@@ -38,6 +38,7 @@ struct ContourCurve {
 };
 
 struct SilhouetteStats {
+  int presubdivisionLevels = 0;  // refinement steps before the method ran (set by its caller)
   SearchStats search;
   size_t contourFaces = 0;    // faces holding at least one contour curve
   size_t correctedFaces = 0;  // faces re-triangulated (contour faces and their edge neighbours)

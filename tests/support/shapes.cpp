@@ -1,6 +1,7 @@
 #include "tests/support/shapes.h"
 
 #include <algorithm>
+#include <sstream>
 
 #include "render/subdiv/limit_surface.h"
 #include "tests/support/corpus.h"
@@ -50,6 +51,49 @@ std::vector<NamedMesh> selectShapes(std::vector<NamedMesh> shapes,
     return std::find(only.begin(), only.end(), s.name) == only.end();
   });
   return shapes;
+}
+
+std::string controlMeshObj(const render::mesh::ControlMesh& mesh) {
+  using render::mesh::BoundaryInterpolation;
+  std::ostringstream out;
+  out.precision(17);
+  for (const auto& p : mesh.points) out << "v " << p.x << " " << p.y << " " << p.z << "\n";
+  size_t offset = 0;
+  for (int count : mesh.faceVertexCounts) {
+    out << "f";
+    for (int k = 0; k < count; ++k) out << " " << mesh.faceVertexIndices[offset + k] + 1;
+    out << "\n";
+    offset += count;
+  }
+  for (const auto& c : mesh.creases) {
+    out << "t crease 2/1/0 " << c.v0 << " " << c.v1 << " " << c.sharpness << "\n";
+  }
+  for (const auto& c : mesh.corners)
+    out << "t corner 1/1/0 " << c.vertex << " " << c.sharpness << "\n";
+  for (int h : mesh.holes) out << "t hole 1/0/0 " << h << "\n";
+  if (mesh.boundary != BoundaryInterpolation::EdgeOnly) {
+    out << "t interpolateboundary 1/0/0 " << (mesh.boundary == BoundaryInterpolation::None ? 0 : 1)
+        << "\n";
+  }
+  if (mesh.creaseMethod == render::mesh::CreaseMethod::Chaikin) {
+    out << "t creasemethod 0/0/1 chaikin\n";
+  }
+  if (mesh.triangleSubdivision == render::mesh::TriangleSubdivision::Smooth) {
+    out << "t smoothtriangles 0/0/1 smooth\n";
+  }
+  return out.str();
+}
+
+const char* schemeName(render::mesh::Scheme scheme) {
+  switch (scheme) {
+    case render::mesh::Scheme::Loop:
+      return "loop";
+    case render::mesh::Scheme::Bilinear:
+      return "bilinear";
+    case render::mesh::Scheme::CatmullClark:
+      break;
+  }
+  return "catmull-clark";
 }
 
 std::string shapeClass(const render::mesh::ControlMesh& mesh) {
