@@ -139,6 +139,7 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
   count("contourPoints", s.search.contourPoints);
   count("contourFaces", s.contourFaces);
   count("correctedFaces", s.correctedFaces);
+  count("trianglesCulled", s.trianglesCulled);
   count("curveSamples", s.curveSamples);
   count("unresolvedSamples", s.unresolvedSamples);
   count("refinedEdges", s.refinedEdges);

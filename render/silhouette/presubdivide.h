@@ -31,7 +31,7 @@ std::string presubdivisionReason(const mesh::ControlMesh& mesh);
 // kMaxChordDeviationPx from the limit surface: a coarse cage of a spiky or strongly curved shape
 // (a cube with infinitely sharp corners) leaves chords so far outside the surface that the
 // per-face corrections cannot bring them in.
-inline constexpr int kMaxPresubdivisionLevels = 3;
+inline constexpr int kMaxPresubdivisionLevels = 4;
 inline constexpr double kMaxChordDeviationPx = 4.0;
 
 // The largest distance, in pixels of `camera` at its depth, between a face's flat piece (its

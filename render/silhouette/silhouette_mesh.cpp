@@ -12,6 +12,8 @@
 
 namespace limn::render::silhouette {
 
+namespace Far = OpenSubdiv::Far;
+
 namespace {
 
 // What one face contributes, built independently of the others.
@@ -23,6 +25,7 @@ struct FacePiece {
   size_t coarseTriangles = 0, curveSamples = 0, unresolved = 0;
   int splits = 0;
   bool odd = false;
+  size_t culled = 0;  // triangles left out as hidden (cullBackFacing)
 };
 
 // A ring face refined by refineConcaveChords: Bfr's tessellation with the face's edge rates
@@ -129,6 +132,40 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
   return piece;
 }
 
+// True when the surface is closed: no boundary or non-manifold edge, no hole. A ray's first hit
+// on a closed surface enters it, so what faces away from the eye is never seen there.
+bool isClosed(const subdiv::LimitSurface& surface) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!surface.hasLimit(f)) return false;
+  }
+  for (int e = 0; e < base.GetNumEdges(); ++e) {
+    if (base.IsEdgeBoundary(e) || base.IsEdgeNonManifold(e)) return false;
+  }
+  return true;
+}
+
+// Leaves out the triangles whose three corners face away from the eye (the cosine between the
+// limit normal and the view ray above kBackFacingCos; contour points, at 0, never count). On a
+// closed surface they are hidden, but their flat chords lie on the eye's side of the true
+// surface, so next to an inner contour they could poke through the front's chords, which lie
+// behind it: the dark fringes of back faces along a fold.
+constexpr double kBackFacingCos = 1e-3;
+
+size_t cullBackFacing(const Camera& camera, FacePiece& piece) {
+  std::vector<bool> back(piece.points.size());
+  for (size_t i = 0; i < piece.points.size(); ++i) {
+    const FacePoint& p = piece.points[i];
+    const Vec3 ray = camera.viewVector(p.position);
+    back[i] = contourFunction(camera, p.position, p.normal) > kBackFacingCos * length(ray);
+  }
+  const size_t before = piece.triangles.size();
+  std::erase_if(piece.triangles, [&](const std::array<int, 3>& t) {
+    return back[t[0]] && back[t[1]] && back[t[2]];
+  });
+  return before - piece.triangles.size();
+}
+
 }  // namespace
 
 SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Camera& camera,
@@ -143,12 +180,14 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
   out.stats.refinedFaces = chords.refinedFaces;
 
   const int faceCount = surface.faceCount();
+  const bool cull = options.cullHidden && isClosed(surface);
   std::vector<FacePiece> pieces(faceCount);
   parallelFor(faceCount, 32, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       if ((f & 63) == 0) cancel.check();
       if (!surface.hasLimit(static_cast<int>(f))) continue;
       pieces[f] = buildFace(domains, camera, out.search, chords, options, static_cast<int>(f));
+      if (cull) pieces[f].culled = cullBackFacing(camera, pieces[f]);
     }
   });
   cancel.check();
@@ -196,6 +235,7 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
     }
     out.stats.curveSamples += piece.curveSamples;
     out.stats.interiorSplits += piece.splits;
+    out.stats.trianglesCulled += piece.culled;
     out.stats.unresolvedSamples += piece.unresolved;
     if (piece.odd) ++out.stats.oddFaces;
     for (ContourCurve& c : piece.curves) {

@@ -27,6 +27,9 @@ struct SilhouetteOptions {
   CurveOptions curves;
   ChordOptions chords;
   size_t maxTriangles = 8'000'000;
+  // On closed surfaces, leave out triangles whose corners all face away from the eye (hidden
+  // there; drawn, their chords can show through along inner contours).
+  bool cullHidden = true;
 };
 
 // One contour curve inside one face, endpoints included (both are edge points).
@@ -47,6 +50,7 @@ struct SilhouetteStats {
   size_t interiorSplits = 0;  // contour-face edges split because their chord lay outside
   size_t trianglesAdded = 0;  // triangles drawn beyond the coarse mesh's
   size_t trianglesDrawn = 0;
+  size_t trianglesCulled = 0;  // facing away on a closed surface, left out (cullHidden)
   size_t curveSamples = 0;
   size_t unresolvedSamples = 0;  // exact samples that found no root (left on the straight line)
   size_t oddFaces = 0;           // faces with an odd crossing count (drawn without a curve)
