@@ -82,17 +82,14 @@ bool isSmoothVertex(const Far::TopologyLevel& level, int v) {
          level.GetVertexSharpness(v) == 0.0f && level.GetVertexEdges(v).size() >= 3;
 }
 
-// Every face of the ring has the scheme's size, is no hole, and has only smooth edges and
-// vertices.
+// Every face of the ring has the scheme's size, is no hole, and has only smooth edges. (Its
+// vertices are the support points, checked once each.)
 bool isSmoothRing(const Far::TopologyLevel& level, const Ring& ring, int faceSize) {
   for (int i = 0; i < ring.count; ++i) {
     const int face = ring.corners[i].face;
     if (level.IsFaceHole(face) || level.GetFaceVertices(face).size() != faceSize) return false;
     for (int e : level.GetFaceEdges(face)) {
       if (level.GetEdgeSharpness(e) != 0.0f || level.IsEdgeNonManifold(e)) return false;
-    }
-    for (int v : level.GetFaceVertices(face)) {
-      if (!isSmoothVertex(level, v)) return false;
     }
   }
   return true;
@@ -227,6 +224,9 @@ std::optional<EdgeSupport> gatherEdgeSupport(const Far::TopologyLevel& level, me
   support.count = 1 + ringSizeA;
   for (int i = leading; i < ringSizeB - trailing; ++i) points[support.count++] = fromB[i];
   if (!allDistinct(points, support.count)) return std::nullopt;
+  for (int i = 2; i < support.count; ++i) {
+    if (!isSmoothVertex(level, points[i])) return std::nullopt;
+  }
   return support;
 }
 

@@ -13,6 +13,7 @@
 #include <random>
 #include <string>
 
+#include "render/silhouette/contour_search.h"
 #include "render/subdiv/limit_surface.h"
 #include "tests/unit/test_meshes.h"
 
@@ -20,7 +21,8 @@ namespace limn::render::silhouette {
 namespace {
 
 namespace Far = OpenSubdiv::Far;
-using limn::testing::addFace;
+using limn::testing::splitBipyramid;
+using limn::testing::splitPrism;
 using mesh::ControlMesh;
 using mesh::Scheme;
 
@@ -31,96 +33,6 @@ constexpr double kNormalTolerance = 1e-9;
 
 double angleBetween(const Vec3& a, const Vec3& b) {
   return std::atan2(length(cross(a, b)), dot(a, b));
-}
-
-// A smooth, non-symmetric displacement, so that no weight can hide behind a symmetry.
-ControlMesh displaced(ControlMesh m, double amount = 0.08) {
-  for (Vec3& p : m.points) {
-    p += Vec3{std::sin(3 * p.y + 1), std::cos(2 * p.z + 0.5), std::sin(4 * p.x + 2 * p.y)} * amount;
-  }
-  return m;
-}
-
-// One topological split: Catmull-Clark's (every face into quads around its centre) or Loop's
-// (every triangle into four), points at averages. A face of n sides becomes a vertex of
-// valence n.
-ControlMesh splitOnce(const ControlMesh& m) {
-  ControlMesh out;
-  out.scheme = m.scheme;
-  out.points = m.points;
-  std::map<std::pair<int, int>, int> midpoints;
-  auto midpoint = [&](int a, int b) {
-    auto [it, inserted] = midpoints.try_emplace({std::min(a, b), std::max(a, b)}, 0);
-    if (inserted) {
-      it->second = static_cast<int>(out.points.size());
-      out.points.push_back((m.points[a] + m.points[b]) * 0.5);
-    }
-    return it->second;
-  };
-  size_t offset = 0;
-  for (int size : m.faceVertexCounts) {
-    const int* v = &m.faceVertexIndices[offset];
-    offset += size;
-    if (m.scheme == Scheme::Loop) {
-      int ab = midpoint(v[0], v[1]), bc = midpoint(v[1], v[2]), ca = midpoint(v[2], v[0]);
-      addFace(out, {v[0], ab, ca});
-      addFace(out, {ab, v[1], bc});
-      addFace(out, {ca, bc, v[2]});
-      addFace(out, {ab, bc, ca});
-      continue;
-    }
-    Vec3 centre;
-    for (int k = 0; k < size; ++k) centre += m.points[v[k]] * (1.0 / size);
-    const int c = static_cast<int>(out.points.size());
-    out.points.push_back(centre);
-    for (int k = 0; k < size; ++k) {
-      addFace(out, {v[k], midpoint(v[k], v[(k + 1) % size]), c,
-                    midpoint(v[(k + size - 1) % size], v[k])});
-    }
-  }
-  return out;
-}
-
-// An n-sided prism, split once: its two cap centres have valence n, its corners 3.
-ControlMesh prism(int n) {
-  ControlMesh m;
-  for (int k = 0; k < n; ++k) {
-    double a = 2 * std::numbers::pi * k / n;
-    m.points.push_back({std::cos(a), std::sin(a), -0.6});
-    m.points.push_back({std::cos(a), std::sin(a), 0.6});
-  }
-  for (int k = 0; k < n; ++k) {
-    int next = (k + 1) % n;
-    addFace(m, {2 * k, 2 * next, 2 * next + 1, 2 * k + 1});
-  }
-  std::vector<int> bottom, top;
-  for (int k = 0; k < n; ++k) {
-    bottom.push_back(2 * (n - 1 - k));
-    top.push_back(2 * k + 1);
-  }
-  m.faceVertexCounts.push_back(n);
-  m.faceVertexIndices.insert(m.faceVertexIndices.end(), bottom.begin(), bottom.end());
-  m.faceVertexCounts.push_back(n);
-  m.faceVertexIndices.insert(m.faceVertexIndices.end(), top.begin(), top.end());
-  return displaced(splitOnce(m));
-}
-
-// An n-sided bipyramid of triangles (Loop), split once: its apices have valence n.
-ControlMesh bipyramid(int n) {
-  ControlMesh m;
-  m.scheme = Scheme::Loop;
-  for (int k = 0; k < n; ++k) {
-    double a = 2 * std::numbers::pi * k / n;
-    m.points.push_back({std::cos(a), std::sin(a), 0});
-  }
-  m.points.push_back({0, 0, 1.2});
-  m.points.push_back({0, 0, -1.2});
-  for (int k = 0; k < n; ++k) {
-    int next = (k + 1) % n;
-    addFace(m, {k, next, n});
-    addFace(m, {next, k, n + 1});
-  }
-  return displaced(splitOnce(m));
 }
 
 // The same mesh with its points renumbered at random and every face's vertex list rotated:
@@ -259,7 +171,7 @@ TEST(EdgeTables, NotEligibleNearSharpFeaturesBoundariesOrTwoExtraordinaryEnds) {
 TEST(EdgeTables, CatmullClarkAgreesWithBfrAlongEveryEligibleEdge) {
   std::map<int, int> byValence;
   for (int n = kMinTableValence; n <= kMaxTableValence; ++n) {
-    Agreement a = compareWithBfr(prism(n));
+    Agreement a = compareWithBfr(splitPrism(n));
     report("prism " + std::to_string(n), a);
     EXPECT_GT(a.eligibleByValence[n], 0) << n;
     for (auto [valence, count] : a.eligibleByValence) byValence[valence] += count;
@@ -274,7 +186,7 @@ TEST(EdgeTables, CatmullClarkAgreesWithBfrAlongEveryEligibleEdge) {
       {"pawn 28", limn::testing::pawn()},
       {"grid 10", limn::testing::grid(10)},
       {"bumpy ball relabelled", relabelled(limn::testing::bumpyBall(6), 7)},
-      {"prism 7 relabelled", relabelled(prism(7), 11)},
+      {"prism 7 relabelled", relabelled(splitPrism(7), 11)},
   };
   for (const auto& [name, m] : meshes) {
     SCOPED_TRACE(name);
@@ -291,7 +203,7 @@ TEST(EdgeTables, CatmullClarkAgreesWithBfrAlongEveryEligibleEdge) {
 TEST(EdgeTables, LoopAgreesWithBfrAlongEveryEligibleEdge) {
   std::map<int, int> byValence;
   for (int n = kMinTableValence; n <= kMaxTableValence; ++n) {
-    Agreement a = compareWithBfr(bipyramid(n));
+    Agreement a = compareWithBfr(splitBipyramid(n));
     report("bipyramid " + std::to_string(n), a);
     EXPECT_GT(a.eligibleByValence[n], 0) << n;
     for (auto [valence, count] : a.eligibleByValence) byValence[valence] += count;
@@ -302,7 +214,7 @@ TEST(EdgeTables, LoopAgreesWithBfrAlongEveryEligibleEdge) {
       {"icosphere 3 (Loop)", limn::testing::icosphere(3, Scheme::Loop)},
       {"icosphere 2 (Loop)", limn::testing::icosphere(2, Scheme::Loop)},
       {"icosphere 3 relabelled", relabelled(limn::testing::icosphere(3, Scheme::Loop), 3)},
-      {"bipyramid 9 relabelled", relabelled(bipyramid(9), 5)},
+      {"bipyramid 9 relabelled", relabelled(splitBipyramid(9), 5)},
   };
   for (const auto& [name, m] : meshes) {
     SCOPED_TRACE(name);
@@ -312,6 +224,40 @@ TEST(EdgeTables, LoopAgreesWithBfrAlongEveryEligibleEdge) {
   }
   Agreement sphere = compareWithBfr(limn::testing::icosphere(3, Scheme::Loop));
   EXPECT_GT(sphere.eligible, 0.9 * sphere.edges);
+}
+
+// The contour search on the tables (SearchOptions::edgeTables) finds the points it finds on Bfr,
+// to rounding, from views all round.
+TEST(EdgeTables, ContourSearchFindsTheSamePointsOnTheTables) {
+  for (const ControlMesh& m :
+       {limn::testing::bumpyBall(8), limn::testing::icosphere(2, Scheme::Loop), splitPrism(9)}) {
+    subdiv::LimitSurface surface(m);
+    const FaceDomains domains(surface);
+    const Bounds box = surface.bounds();
+    const double diagonal = length(box.hi - box.lo);
+    SearchOptions onBfr, onTables;
+    onTables.edgeTables = true;
+    for (const Vec3& eye : {Vec3{0.3, 0.4, 4}, Vec3{-3, 1, 1.5}, Vec3{2, -2.5, -1}}) {
+      CameraSpec spec;
+      spec.eye = eye;
+      const Camera camera = resolveCamera(spec, box);
+      ContourSearch a = searchContour(domains, camera, onBfr, CancelToken());
+      ContourSearch b = searchContour(domains, camera, onTables, CancelToken());
+      EXPECT_EQ(a.stats.edgesOnTables, 0u);
+      EXPECT_GT(b.stats.edgesOnTables, 0.9 * b.stats.edgesSampled);
+      ASSERT_EQ(a.stats.contourPoints, b.stats.contourPoints);
+      EXPECT_GT(b.stats.contourPoints, 0u);
+      for (size_t e = 0; e < a.edgePoints.size(); ++e) {
+        ASSERT_EQ(a.edgePoints[e].size(), b.edgePoints[e].size()) << e;
+        for (size_t i = 0; i < a.edgePoints[e].size(); ++i) {
+          EXPECT_NEAR(a.edgePoints[e][i].t, b.edgePoints[e][i].t, 1e-12);
+          EXPECT_EQ(a.edgePoints[e][i].sides, b.edgePoints[e][i].sides);
+          EXPECT_LT(length(a.edgePoints[e][i].position - b.edgePoints[e][i].position),
+                    1e-12 * diagonal);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
