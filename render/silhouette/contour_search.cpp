@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 
 #include "render/core/parallel.h"
 #include "render/mesh/control_mesh.h"
+#include "render/silhouette/edge_tables.h"
 
 namespace limn::render::silhouette {
 
@@ -41,32 +43,63 @@ EdgeInFace locateEdge(const Far::TopologyLevel& base, int face, int edge) {
   return {};
 }
 
-// g along one edge as seen from one face.
+// g along one edge as seen from one face. With SearchOptions::edgeTables, where the tables cover
+// the edge (gathered on the first sample, as most edges are never sampled), g at t = k/128 is
+// summed from them; every other t (the slope probes, the extremum) and every other edge goes
+// to the face's surface.
 class EdgeProbe {
  public:
-  EdgeProbe(const FaceDomains& domains, const Camera& camera, int face, int edge)
+  EdgeProbe(const FaceDomains& domains, const Camera& camera, int face, int edge, bool useTables)
       : domains_(domains),
         camera_(camera),
         face_(face),
+        edge_(edge),
         from_(edgeUV(domains, face, edge, 0.0)),
-        to_(edgeUV(domains, face, edge, 1.0)) {}
+        to_(edgeUV(domains, face, edge, 1.0)),
+        tablesLookedUp_(!useTables) {}
 
   double g(double t) const {
+    const double step = t * kEdgeTableSteps;
+    if (step == std::floor(step)) {
+      if (const EdgeCurve* curve = tables()) {
+        EdgeSample s = curve->sample(static_cast<int>(step));
+        return contourFunction(camera_, s.position, s.normal);
+      }
+    }
+    return surfaceG(t);
+  }
+  // Both ends of the difference from the surface, also where one is t = 0 or 1.
+  double slope(double t) const {
+    const double h = 1e-4;
+    double a = std::max(0.0, t - h), b = std::min(1.0, t + h);
+    return (surfaceG(b) - surfaceG(a)) / (b - a);
+  }
+  bool onTables() const { return curve_.has_value(); }
+
+ private:
+  const EdgeCurve* tables() const {
+    if (!tablesLookedUp_) {
+      tablesLookedUp_ = true;
+      const subdiv::LimitSurface& surface = domains_.surface();
+      if (auto support = gatherEdgeSupport(surface.baseLevel(), surface.mesh().scheme, edge_)) {
+        curve_.emplace(*support, surface.mesh().points, surface.mesh().scheme);
+      }
+    }
+    return curve_ ? &*curve_ : nullptr;
+  }
+  double surfaceG(double t) const {
     subdiv::LimitSample s = domains_.evaluate(
         face_, {from_.x + (to_.x - from_.x) * t, from_.y + (to_.y - from_.y) * t});
     return contourFunction(camera_, s.position, s.normal);
   }
-  double slope(double t) const {
-    const double h = 1e-4;
-    double a = std::max(0.0, t - h), b = std::min(1.0, t + h);
-    return (g(b) - g(a)) / (b - a);
-  }
 
- private:
   const FaceDomains& domains_;
   const Camera& camera_;
-  int face_;
+  int face_, edge_;
   Vec2 from_, to_;
+  // Looked up lazily from the const g(); a probe serves one edge on one thread.
+  mutable bool tablesLookedUp_;
+  mutable std::optional<EdgeCurve> curve_;
 };
 
 // Narrows a sign change of g in [a, b] by bisection, then interpolates linearly.
@@ -146,7 +179,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
     return false;
   };
 
-  std::atomic<size_t> tested{0}, signChanges{0}, sampled{0}, doubles{0}, outlines{0};
+  std::atomic<size_t> tested{0}, signChanges{0}, sampled{0}, doubles{0}, outlines{0}, onTables{0};
   out.edgePoints.resize(base.GetNumEdges());
   parallelFor(base.GetNumEdges(), 64, [&](size_t begin, size_t end) {
     std::vector<EdgePoint> found;
@@ -179,7 +212,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
         const int face = faces[k];
         size_t c0 = cornerIndex(face, ends[0]), c1 = cornerIndex(face, ends[1]);
         double g0 = out.cornerG[c0], g1 = out.cornerG[c1];
-        EdgeProbe probe(domains, camera, face, static_cast<int>(e));
+        EdgeProbe probe(domains, camera, face, static_cast<int>(e), options.edgeTables);
         const uint32_t bits = split ? (1u << k) : allSides;
 
         bool sample = signOf(g0) != signOf(g1);
@@ -232,6 +265,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
           }
         }
         if (signOf(g0) == signOf(g1) && found.size() > foundBefore) ++doubles;
+        if (probe.onTables()) ++onTables;
         if (!split) break;  // one face sees the whole edge
       }
       // Outline edges: shaped along their limit curve wherever they could show.
@@ -277,6 +311,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
   out.stats.edgesSampled = sampled;
   out.stats.doubleCrossings = doubles;
   out.stats.outlineEdges = outlines;
+  out.stats.edgesOnTables = onTables;
   for (const auto& points : out.edgePoints) out.stats.contourPoints += points.size();
   return out;
 }

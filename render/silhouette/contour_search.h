@@ -42,6 +42,13 @@ struct SearchOptions {
   // `pixelsPerSample` pixels, at most `outlineSamples` per edge.
   double pixelsPerSample = 2.0;
   int outlineSamples = 32;
+  // True: g at the dyadic parameters the sampling and bisection reach (multiples of 1/128)
+  // comes from the edge tables (edge_tables.h) on the edges they cover, rather than from Bfr;
+  // the same values to rounding. Off by default: the search evaluates only about 4 such points
+  // per sampled edge (most hold no crossing; the slope probes and face corners stay on Bfr), too
+  // few to pay for gathering the edge's support, and it measured no faster
+  // (bench/edge_table_results.md).
+  bool edgeTables = false;
 };
 
 // A point on the limit curve of a base edge where g changes sign for at least one of the
@@ -59,6 +66,7 @@ struct SearchStats {
   size_t edgesSampled = 0;         // searched inside because the bound could not clear them
   size_t doubleCrossings = 0;      // edges with ends of the same sign and crossings inside
   size_t outlineEdges = 0;         // boundary or sharp edges drawn along their limit curve
+  size_t edgesOnTables = 0;        // sampled edges whose dyadic samples came from edge tables
   size_t contourPoints = 0;        // distinct edge points
 };
 

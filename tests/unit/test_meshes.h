@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <map>
 #include <numbers>
 #include <vector>
 
@@ -326,6 +327,97 @@ inline ControlMesh gridWithValenceTwoVertex(int n = 4, double amplitude = 0.2) {
   addFace(m, {a, b, c, x});
   addFace(m, {a, x, c, d});
   return m;
+}
+
+// A smooth, non-symmetric displacement, so that no weight can hide behind a symmetry.
+inline ControlMesh displaced(ControlMesh m, double amount = 0.08) {
+  for (Vec3& p : m.points) {
+    p += Vec3{std::sin(3 * p.y + 1), std::cos(2 * p.z + 0.5), std::sin(4 * p.x + 2 * p.y)} * amount;
+  }
+  return m;
+}
+
+// One topological split: Catmull-Clark's (every face into quads around its centre) or Loop's
+// (every triangle into four), points at averages. A face of n sides becomes a vertex of
+// valence n.
+inline ControlMesh splitOnce(const ControlMesh& m) {
+  ControlMesh out;
+  out.scheme = m.scheme;
+  out.points = m.points;
+  std::map<std::pair<int, int>, int> midpoints;
+  auto midpoint = [&](int a, int b) {
+    auto [it, inserted] = midpoints.try_emplace({std::min(a, b), std::max(a, b)}, 0);
+    if (inserted) {
+      it->second = static_cast<int>(out.points.size());
+      out.points.push_back((m.points[a] + m.points[b]) * 0.5);
+    }
+    return it->second;
+  };
+  size_t offset = 0;
+  for (int size : m.faceVertexCounts) {
+    const int* v = &m.faceVertexIndices[offset];
+    offset += size;
+    if (m.scheme == Scheme::Loop) {
+      int ab = midpoint(v[0], v[1]), bc = midpoint(v[1], v[2]), ca = midpoint(v[2], v[0]);
+      addFace(out, {v[0], ab, ca});
+      addFace(out, {ab, v[1], bc});
+      addFace(out, {ca, bc, v[2]});
+      addFace(out, {ab, bc, ca});
+      continue;
+    }
+    Vec3 centre;
+    for (int k = 0; k < size; ++k) centre += m.points[v[k]] * (1.0 / size);
+    const int c = static_cast<int>(out.points.size());
+    out.points.push_back(centre);
+    for (int k = 0; k < size; ++k) {
+      addFace(out, {v[k], midpoint(v[k], v[(k + 1) % size]), c,
+                    midpoint(v[(k + size - 1) % size], v[k])});
+    }
+  }
+  return out;
+}
+
+// An n-sided prism, split once: its two cap centres have valence n, its corners 3 (edge tables
+// of every valence, issue 10).
+inline ControlMesh splitPrism(int n) {
+  ControlMesh m;
+  for (int k = 0; k < n; ++k) {
+    double a = 2 * std::numbers::pi * k / n;
+    m.points.push_back({std::cos(a), std::sin(a), -0.6});
+    m.points.push_back({std::cos(a), std::sin(a), 0.6});
+  }
+  for (int k = 0; k < n; ++k) {
+    int next = (k + 1) % n;
+    addFace(m, {2 * k, 2 * next, 2 * next + 1, 2 * k + 1});
+  }
+  std::vector<int> bottom, top;
+  for (int k = 0; k < n; ++k) {
+    bottom.push_back(2 * (n - 1 - k));
+    top.push_back(2 * k + 1);
+  }
+  m.faceVertexCounts.push_back(n);
+  m.faceVertexIndices.insert(m.faceVertexIndices.end(), bottom.begin(), bottom.end());
+  m.faceVertexCounts.push_back(n);
+  m.faceVertexIndices.insert(m.faceVertexIndices.end(), top.begin(), top.end());
+  return displaced(splitOnce(m));
+}
+
+// An n-sided bipyramid of triangles (Loop), split once: its apices have valence n.
+inline ControlMesh splitBipyramid(int n) {
+  ControlMesh m;
+  m.scheme = Scheme::Loop;
+  for (int k = 0; k < n; ++k) {
+    double a = 2 * std::numbers::pi * k / n;
+    m.points.push_back({std::cos(a), std::sin(a), 0});
+  }
+  m.points.push_back({0, 0, 1.2});
+  m.points.push_back({0, 0, -1.2});
+  for (int k = 0; k < n; ++k) {
+    int next = (k + 1) % n;
+    addFace(m, {k, next, n});
+    addFace(m, {next, k, n + 1});
+  }
+  return displaced(splitOnce(m));
 }
 
 }  // namespace limn::testing
