@@ -221,26 +221,10 @@ void printClassTable(const std::vector<ViewResult>& all) {
   std::printf("\n");
 }
 
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '\n') {
-      out += "\\n";
-    } else {
-      if (c == '"' || c == '\\') out += '\\';
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
 void dumpRequest(const ViewResult& v, const std::string& dir) {
   std::filesystem::create_directories(dir);
   std::ofstream out(dir + "/" + v.shape + "-view" + std::to_string(v.view) + ".json");
-  out << "{\"mesh\": {\"format\": \"obj\", \"scheme\": \""
-      << testing::schemeName(v.mesh->mesh.scheme)
-      << "\", \"data\": " << jsonString(testing::controlMeshObj(v.mesh->mesh))
-      << "},\n \"camera\": " << v.camera
+  out << "{\"mesh\": " << testing::requestMeshJson(v.mesh->mesh) << ",\n \"camera\": " << v.camera
       << ",\n \"method\": \"silhouette\", \"reference\": true,"
          " \"outputs\": [\"color\", \"diff\", \"contours\"]}\n";
 }

@@ -13,8 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "render/subdiv/limit_surface.h"
 #include "tests/integration/http_client.h"
 #include "tests/integration/server_process.h"
+#include "tests/support/random_views.h"
+#include "tests/support/shapes.h"
 
 namespace limn::testing {
 namespace {
@@ -323,6 +326,26 @@ TEST_F(SilhouetteEndpointTest, TorusFromALowAngleHidesPartOfItsInnerOutline) {
   EXPECT_GT(hiddenInner, 10u);
   EXPECT_GT(visibleInner, 10u) << "the far rim of the hole is seen above the near tube";
   EXPECT_GE(doc["stats"]["hiddenPieces"].GetInt(), 1);
+}
+
+// The project's sharp-feature meshes and its all-triangle Catmull-Clark sphere through
+// POST /v1/render, each from a random view: the outline within a pixel of the exact one.
+TEST_F(SilhouetteEndpointTest, SharpAndDenseMeshesFromRandomViewsRenderWithinAPixel) {
+  for (const NamedMesh& shape :
+       selectShapes(ownShapes(), {"own_sharp_cube", "own_semisharp_cube", "own_chaikin_cube",
+                                  "own_sharp_tetrahedron_loop", "own_tri_sphere_1280"})) {
+    render::subdiv::LimitSurface surface(shape.mesh);
+    RandomView view = randomViews(surface.bounds(), 1, viewSeed(3, shape.name), 256)[0];
+    std::string body = R"({"mesh": )" + requestMeshJson(shape.mesh) + R"(, "camera": )" +
+                       describeCamera(view.camera) +
+                       R"(, "method": "silhouette", "reference": true, "outputs": []})";
+    HttpResponse r = post(port(), "/v1/render", body);
+    ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
+    auto doc = parseJson(r.body);
+    EXPECT_LE(doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 1.0)
+        << shape.name << " camera " << describeCamera(view.camera);
+    EXPECT_TRUE(doc["stats"]["silhouette"].HasMember("presubdivisionLevels"));
+  }
 }
 
 TEST_F(SilhouetteEndpointTest, BadRequestsName400FieldsAndTheServerCarriesOn) {

@@ -84,16 +84,18 @@ std::string controlMeshObj(const render::mesh::ControlMesh& mesh) {
   return out.str();
 }
 
-const char* schemeName(render::mesh::Scheme scheme) {
-  switch (scheme) {
-    case render::mesh::Scheme::Loop:
-      return "loop";
-    case render::mesh::Scheme::Bilinear:
-      return "bilinear";
-    case render::mesh::Scheme::CatmullClark:
-      break;
+std::string requestMeshJson(const render::mesh::ControlMesh& mesh) {
+  std::string data;
+  for (char c : controlMeshObj(mesh)) {
+    if (c == '\n') {
+      data += "\\n";
+    } else {
+      if (c == '"' || c == '\\') data += '\\';
+      data += c;
+    }
   }
-  return "catmull-clark";
+  return std::string(R"({"format": "obj", "scheme": ")") + render::mesh::schemeName(mesh.scheme) +
+         R"(", "data": ")" + data + "\"}";
 }
 
 std::string shapeClass(const render::mesh::ControlMesh& mesh) {

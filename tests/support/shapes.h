@@ -27,8 +27,8 @@ std::vector<NamedMesh> selectShapes(std::vector<NamedMesh> shapes,
 // The mesh as OBJ text with OpenSubdiv's tag lines (creases, corners, holes, boundary and
 // crease rules), as a request's {"format": "obj"} mesh takes it: for reproducing a view.
 std::string controlMeshObj(const render::mesh::ControlMesh& mesh);
-// The request's "scheme" for the mesh: "catmull-clark", "loop" or "bilinear".
-const char* schemeName(render::mesh::Scheme scheme);
+// The mesh as a request's "mesh" object: {"format": "obj", "scheme": ..., "data": "..."}.
+std::string requestMeshJson(const render::mesh::ControlMesh& mesh);
 
 // "closed smooth", "closed semi-sharp", "closed sharp" or "open": a closed mesh has no boundary
 // or non-manifold edge and no hole; sharp means an infinitely sharp crease or corner.

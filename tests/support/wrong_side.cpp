@@ -9,8 +9,8 @@ namespace {
 // Per pixel: covered in both (alpha > 0.5) and on different sides; empty when the images do
 // not match.
 std::vector<char> wrongSideMap(const render::Image& color, const render::Image& reference) {
-  if (reference.width != color.width || reference.height != color.height ||
-      color.channels != 4 || reference.channels != 4) {
+  if (reference.width != color.width || reference.height != color.height || color.channels != 4 ||
+      reference.channels != 4) {
     return {};
   }
   const size_t pixels = static_cast<size_t>(color.width) * color.height;
