@@ -30,8 +30,9 @@ std::string presubdivisionReason(const mesh::ControlMesh& mesh);
 // the refined mesh stays under 4 x kAutoFaceLimit faces) while the flat faces are further than
 // kMaxChordDeviationPx from the limit surface: a coarse cage of a spiky or strongly curved shape
 // (a cube with infinitely sharp corners) leaves chords so far outside the surface that the
-// per-face corrections cannot bring them in.
-inline constexpr int kMaxPresubdivisionLevels = 4;
+// per-face corrections cannot bring them in. Not a fourth level: that would draw as many faces
+// as uniform level 4, which the method must stay under.
+inline constexpr int kMaxPresubdivisionLevels = 3;
 inline constexpr double kMaxChordDeviationPx = 4.0;
 
 // The largest distance, in pixels of `camera` at its depth, between a face's flat piece (its

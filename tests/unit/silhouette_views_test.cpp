@@ -44,7 +44,8 @@ struct Allowance {
 };
 
 Allowance allowanceFor(const std::string& shape, bool closed) {
-  if (shape == "own_cube_sharp_corners") return {3.1, 2};
+  // Its spike tips: 2.6-4.1 px with 3 pre-subdivision levels (docs/engine.md).
+  if (shape == "own_cube_sharp_corners") return {4.1, 3};
   if (shape == "catmark_val2_interior" || shape == "loop_triangle_edgecorner") return {3.0, 2};
   return closed ? Allowance{1.0, 0} : Allowance{3.0, 1};
 }
