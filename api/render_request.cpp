@@ -38,18 +38,13 @@ void warnUnknownFields(const Value& object, const std::string& prefix,
 }
 
 Method parseMethod(const Value& value) {
-  std::string_view name = json::string(value, "method");
-  if (name == "patches") {
-    json::fail("method", "method " + json::quote(name) +
-                             " is not implemented yet; available: \"coarse\", \"uniform\", "
-                             "\"adaptive\", \"limit\", \"silhouette\"");
-  }
   return json::choice<Method>(value, "method",
                               {{"coarse", Method::Coarse},
                                {"uniform", Method::Uniform},
                                {"adaptive", Method::Adaptive},
                                {"limit", Method::Limit},
-                               {"silhouette", Method::Silhouette}});
+                               {"silhouette", Method::Silhouette},
+                               {"patches", Method::Patches}});
 }
 
 // params of the silhouette method (read whatever the method; they only matter to it).
@@ -91,11 +86,11 @@ void parseSilhouetteParams(const Value& params, const JobLimits& limits,
 render::pipeline::MethodParams parseParams(const Value& params, const JobLimits& limits,
                                            std::vector<std::string>& warnings) {
   json::requireObject(params, "params");
-  warnUnknownFields(
-      params, "params",
-      {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample", "referenceCrossCheck",
-       "presubdivide", "searchSteps", "curveSamples", "contour"},
-      warnings);
+  warnUnknownFields(params, "params",
+                    {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample",
+                     "referenceCrossCheck", "presubdivide", "searchSteps", "curveSamples",
+                     "contour", "isolation", "cullPatches", "tessellator"},
+                    warnings);
   render::pipeline::MethodParams out;
   if (const Value* v = json::find(params, "level")) {
     out.level = json::integer(*v, "params.level");
@@ -126,6 +121,31 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
                          json::formatNumber(limits.minDicingRate) + " pixels)");
     }
   }
+  if (const Value* v = json::find(params, "isolation")) {
+    out.isolation = json::integer(*v, "params.isolation");
+    if (out.isolation < 1) json::fail("params.isolation", "params.isolation must be >= 1");
+    if (out.isolation > limits.maxIsolation) {
+      throw tooLarge("maxIsolation", "params.isolation",
+                     "params.isolation " + std::to_string(out.isolation) +
+                         " exceeds limit maxIsolation (" + std::to_string(limits.maxIsolation) +
+                         ")");
+    }
+  }
+  if (const Value* v = json::find(params, "cullPatches")) {
+    out.cullPatches = json::boolean(*v, "params.cullPatches");
+  }
+  if (const Value* v = json::find(params, "tessellator")) {
+    std::string_view tessellator = json::string(*v, "params.tessellator");
+    if (tessellator == "gpu") {
+      json::fail("params.tessellator",
+                 "params.tessellator \"gpu\" (tessellation shaders) is not implemented yet; "
+                 "\"cpu\" is");
+    }
+    if (tessellator != "cpu") {
+      json::fail("params.tessellator",
+                 "params.tessellator must be \"cpu\"; got " + json::quote(tessellator));
+    }
+  }
   if (const Value* v = json::find(params, "referenceCrossCheck")) {
     out.referenceCrossCheck = json::boolean(*v, "params.referenceCrossCheck");
   }
@@ -149,7 +169,7 @@ render::pipeline::Outputs readOutputs(const Value& value) {
   json::requireArray(value, "outputs");
   render::pipeline::Outputs out;
   out.color = false;
-  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours, Cage, Diff };
+  enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours, Cage, Diff, Patches };
   for (rapidjson::SizeType i = 0; i < value.Size(); ++i) {
     Pass pass = json::choice<Pass>(value[i], "outputs[" + std::to_string(i) + "]",
                                    {{"color", Color},
@@ -159,9 +179,10 @@ render::pipeline::Outputs readOutputs(const Value& value) {
                                     {"wireframe", Wireframe},
                                     {"contours", Contours},
                                     {"cage", Cage},
-                                    {"diff", Diff}});
-    bool* flags[] = {&out.color,     &out.mask,     &out.depth, &out.normal,
-                     &out.wireframe, &out.contours, &out.cage,  &out.diff};
+                                    {"diff", Diff},
+                                    {"patches", Patches}});
+    bool* flags[] = {&out.color,    &out.mask, &out.depth, &out.normal, &out.wireframe,
+                     &out.contours, &out.cage, &out.diff,  &out.patches};
     *flags[pass] = true;
   }
   return out;
@@ -247,6 +268,9 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   if (const Value* v = json::find(root, "outputs")) job.outputs = readOutputs(*v);
   if (job.outputs.contours && job.method != Method::Silhouette) {
     json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
+  }
+  if (job.outputs.patches && job.method != Method::Patches) {
+    json::fail("outputs", "output \"patches\" is drawn by method \"patches\" only");
   }
   if (job.outputs.cage && job.method == Method::Limit) {
     json::fail("outputs",

@@ -31,6 +31,7 @@ std::vector<const char*> requestedPasses(const Outputs& outputs) {
   if (outputs.contours) names.push_back(render::pass::kContours);
   if (outputs.cage) names.push_back(render::pass::kCage);
   if (outputs.diff) names.push_back(render::pass::kDiff);
+  if (outputs.patches) names.push_back(render::pass::kPatches);
   return names;
 }
 
@@ -38,12 +39,13 @@ void writeImages(Writer& w, const render::ImageSet& images, const AnswerShape& s
                  const char* owner, std::vector<std::string>& warnings) {
   w.StartObject();
   for (const char* name : requestedPasses(shape.outputs)) {
-    // The contour and cage overlays are drawn over the method's image, and the diff compares
-    // it with the reference; the reference has none of them.
+    // The contour and cage overlays are drawn over the method's image, the diff compares it
+    // with the reference and the patch image shows its patches; the reference has none.
     if (std::string_view(owner) == "reference" &&
         (std::string_view(name) == render::pass::kContours ||
          std::string_view(name) == render::pass::kCage ||
-         std::string_view(name) == render::pass::kDiff)) {
+         std::string_view(name) == render::pass::kDiff ||
+         std::string_view(name) == render::pass::kPatches)) {
       continue;
     }
     const render::Image* image = images.find(name);
@@ -180,6 +182,40 @@ void writeImplicitStats(Writer& w, const render::pipeline::Stats::Implicit& s) {
   w.EndObject();
 }
 
+void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
+  namespace patches = render::patches;
+  w.Key("patchTable");
+  w.StartObject();
+  auto count = [&](const char* key, size_t value) {
+    w.Key(key);
+    w.Uint64(value);
+  };
+  w.Key("isolation");
+  w.Int(s.table.isolation);
+  count("patches", s.table.patches);
+  w.Key("byLevel");
+  w.StartArray();
+  for (size_t level = 0; level < s.table.byLevel.size(); ++level) {
+    w.StartObject();
+    count("level", level);
+    for (int k = 0; k < patches::kPatchKinds; ++k) {
+      count(patches::patchKindName(static_cast<patches::PatchKind>(k)), s.table.byLevel[level][k]);
+    }
+    w.EndObject();
+  }
+  w.EndArray();
+  count("refinedPoints", s.table.refinedPoints);
+  count("endCapPoints", s.table.endCapPoints);
+  count("patchesDrawn", s.tessellation.patchesDrawn);
+  count("patchesCulled", s.tessellation.patchesCulled);
+  count("patchesOffScreen", s.tessellation.patchesOffScreen);
+  count("transitionEdges", s.tessellation.transitionEdges);
+  count("clampedEdges", s.tessellation.clampedEdges);
+  numberField(w, "tableMs", s.tableMs);
+  numberField(w, "tessellateMs", s.tessellateMs);
+  w.EndObject();
+}
+
 void writeStats(Writer& w, const render::pipeline::Stats& s) {
   w.StartObject();
   w.Key("controlVertices");
@@ -204,6 +240,7 @@ void writeStats(Writer& w, const render::pipeline::Stats& s) {
     }
   }
   if (s.silhouette) writeSilhouetteStats(w, *s.silhouette, s.presubdivided);
+  if (s.patchTable) writePatchStats(w, *s.patchTable);
   if (s.implicit) {
     w.Key("closed");
     w.Bool(s.implicit->closure.closed());

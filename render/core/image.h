@@ -34,8 +34,9 @@ inline constexpr const char* kDepth = "depth";          // 1 channel, linear dep
 inline constexpr const char* kNormal = "normal";        // 3 channels, unit world normal
 inline constexpr const char* kWireframe = "wireframe";  // RGBA, colour with edges drawn over
 inline constexpr const char* kContours = "contours";    // RGBA, colour with the contour drawn over
-inline constexpr const char* kCage = "cage";  // RGBA, colour with the control cage drawn over
-inline constexpr const char* kDiff = "diff";  // RGBA, heat map of the colour difference
+inline constexpr const char* kCage = "cage";        // RGBA, colour with the control cage drawn over
+inline constexpr const char* kDiff = "diff";        // RGBA, heat map of the colour difference
+inline constexpr const char* kPatches = "patches";  // RGBA, colour by patch level and kind
 }  // namespace pass
 
 // The passes of one rendering (approximation or reference) of one camera.

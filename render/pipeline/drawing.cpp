@@ -6,6 +6,7 @@
 #include "render/core/error.h"
 #include "render/normalmap/mapped_cage.h"
 #include "render/normalmap/normal_atlas.h"
+#include "render/patches/patch_image.h"
 #include "render/pipeline/job_checks.h"
 #include "render/pipeline/measure.h"
 #include "render/pipeline/silhouette_build.h"
@@ -73,10 +74,36 @@ tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobL
     }
     case Method::Limit:
     case Method::Silhouette:
+    case Method::Patches:
       break;
   }
   throw std::logic_error(std::string("method ") + methodName(choice.method) +
                          " is not tessellated here");
+}
+
+// The patches method: Far's feature-adaptive patch table, tessellated for the camera.
+void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
+                            const Camera& camera, const CancelToken& cancel, Approximated& out) {
+  Stopwatch clock;
+  const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel);
+  Stats::Patches stats{.table = set.stats(), .tessellation = {}, .tableMs = clock.lapMs()};
+  patches::TessellationOptions options;
+  options.dicingRate = choice.params.dicingRate;
+  options.cullHidden = choice.params.cullPatches;
+  options.maxTriangles = limits.maxTriangles;
+  patches::PatchMesh tessellation = patches::tessellatePatches(set, camera, options, cancel);
+  stats.tessellation = tessellation.stats;
+  stats.tessellateMs = clock.lapMs();
+  if (tessellation.stats.clampedEdges > 0) {
+    out.warnings.push_back(std::to_string(tessellation.stats.clampedEdges) +
+                           " patch edges wanted more than " +
+                           std::to_string(options.maxEdgeFactor) +
+                           " segments; raise params.isolation for finer patches");
+  }
+  if (choice.outputs.patches) out.patchImageMesh = patches::patchColoredMesh(tessellation, set);
+  out.stats.patches = set.stats().patches;
+  out.stats.patchTable = stats;
+  out.mesh = std::move(tessellation.mesh);
 }
 
 }  // namespace
@@ -99,6 +126,8 @@ Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limi
           silhouette::contourOverlay(out.drawnOn(surface), build.built, pass::kContours));
     }
     out.mesh = std::move(build.built.mesh);
+  } else if (choice.method == Method::Patches) {
+    approximateWithPatches(choice, limits, camera, cancel, out);
   } else {
     out.mesh = tessellateMethod(choice, limits, surface, camera, cancel);
   }
@@ -135,6 +164,11 @@ MethodDrawing drawMethod(const MethodChoice& choice, const JobLimits& limits,
   if (context.rasterizer == nullptr) throw std::runtime_error("no rasterizer in this context");
   drawing.images = context.rasterizer->render(drawing.approx.mesh, camera, passes, choice.shading,
                                               drawing.approx.overlays, cancel);
+  if (drawing.approx.patchImageMesh) {
+    ImageSet patchImage = context.rasterizer->render(*drawing.approx.patchImageMesh, camera,
+                                                     {.color = true}, Shading::Smooth, {}, cancel);
+    drawing.images.passes[pass::kPatches] = std::move(patchImage.passes.at(pass::kColor));
+  }
   drawing.rasterMs = clock.lapMs();
   cancel.check();
   return drawing;
@@ -173,6 +207,9 @@ void checkMethod(const MethodChoice& choice, const JobLimits& limits) {
       const char* name = p.engine == Engine::Masks ? "\"masks\"" : "\"factored\"";
       badParameter("params.engine", std::string(name) + " cannot refine this mesh: " + whyNot);
     }
+  }
+  if (p.isolation < 1 || p.isolation > limits.maxIsolation) {
+    badParameter("params.isolation", "must be in 1.." + std::to_string(limits.maxIsolation));
   }
   if (p.level < 0 || p.level > limits.maxLevel) {
     badParameter("params.level", "must be in 0.." + std::to_string(limits.maxLevel));

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,9 @@ struct Approximated {
   // the mesh's faces and (u, v) refer to it.
   std::unique_ptr<subdiv::LimitSurface> presubdivided;
   std::vector<LineOverlay> overlays;  // the outputs drawn over the colour: contours, cage
-  Stats stats;                        // triangles, vertices and the silhouette method's counts
+  // The patches method's mesh coloured by patch (outputs.patches), drawn as its own pass.
+  std::optional<tessellate::TriangleMesh> patchImageMesh;
+  Stats stats;  // triangles, vertices and the silhouette method's counts
   double approxMs = 0;
   std::vector<std::string> warnings;
 

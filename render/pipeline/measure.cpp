@@ -61,6 +61,7 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   if (!isReference) keep(outputs.contours, pass::kContours);
   if (!isReference) keep(outputs.cage, pass::kCage);
   if (!isReference) keep(outputs.diff, pass::kDiff);
+  if (!isReference) keep(outputs.patches, pass::kPatches);
   return selected;
 }
 

@@ -17,6 +17,8 @@
 #include "render/mesh/control_mesh.h"
 #include "render/metrics/metrics.h"
 #include "render/oracle/reference.h"
+#include "render/patches/patch_set.h"
+#include "render/patches/patch_tessellation.h"
 #include "render/silhouette/presubdivide.h"
 #include "render/silhouette/silhouette_mesh.h"
 
@@ -26,7 +28,7 @@ class Rasterizer;
 
 namespace limn::render::pipeline {
 
-enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette };
+enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette, Patches };
 
 // Who refines for method "uniform": OpenSubdiv's Far, or limn's own rules (render/rules) by
 // masks or, for Catmull-Clark, in factored form.
@@ -36,8 +38,10 @@ struct MethodParams {
   int level = 3;                       // uniform
   Engine engine = Engine::OpenSubdiv;  // uniform
   bool pushToLimit = false;            // uniform: move every refined vertex to its limit position
-  double dicingRate = 1.0;             // adaptive: target edge length in pixels
-  int metricSupersample = 4;           // S for the silhouette metrics
+  double dicingRate = 1.0;             // adaptive, patches: target edge length in pixels
+  int isolation = patches::kDefaultIsolation;  // patches: Far's adaptive isolation level
+  bool cullPatches = true;    // patches: leave out patches outside the view or facing away
+  int metricSupersample = 4;  // S for the silhouette metrics
   // Also ray-cast Embree's own subdivision geometry and report its agreement with the reference
   // (Catmull-Clark only; costs about as much as the reference itself).
   bool referenceCrossCheck = false;
@@ -53,6 +57,7 @@ struct Outputs {
   bool contours = false;  // silhouette: contour curves, corrected faces, searched edges
   bool cage = false;      // the control mesh's edges drawn over the colour image
   bool diff = false;      // a heat map of the colour difference against the reference
+  bool patches = false;   // patches: each pixel coloured by its patch's level and kind
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.
@@ -64,6 +69,7 @@ struct JobLimits {
   // 16384^2 by default, i.e. 4096^2 at S = 4 or 2048^2 at S = 8.
   size_t maxSupersampledPixels = size_t{1} << 28;
   int maxLevel = 6;
+  int maxIsolation = patches::kMaxIsolation;
   double minDicingRate = 0.25;
   int maxSearchSteps = 30;
   int maxCurveSamples = 256;
@@ -103,6 +109,13 @@ struct Stats {
   // The silhouette method's own counts (absent for other methods).
   std::optional<silhouette::SilhouetteStats> silhouette;
   bool presubdivided = false;
+  // The patches method's table and tessellation (absent for other methods).
+  struct Patches {
+    patches::PatchTableStats table;
+    patches::TessellationStats tessellation;
+    double tableMs = 0, tessellateMs = 0;
+  };
+  std::optional<Patches> patchTable;
   // Implicit jobs: what the polygoniser did and how closed its mesh is.
   struct Implicit {
     size_t primitives = 0;

@@ -88,6 +88,8 @@ Approximation approximate(const RenderJob& job, const JobLimits& limits,
   out.stats.vertices = made.stats.vertices;
   out.stats.silhouette = made.stats.silhouette;
   out.stats.presubdivided = made.stats.presubdivided;
+  out.stats.patches = made.stats.patches;
+  out.stats.patchTable = made.stats.patchTable;
   out.warnings = std::move(made.warnings);
   out.timings.approxMs = clock.lapMs();
   out.timings.totalMs = total.lapMs();
@@ -106,6 +108,8 @@ const char* methodName(Method method) {
       return "limit";
     case Method::Silhouette:
       return "silhouette";
+    case Method::Patches:
+      return "patches";
   }
   return "?";
 }
@@ -144,6 +148,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     result.stats.vertices = approx.stats.vertices;
     result.stats.silhouette = approx.stats.silhouette;
     result.stats.presubdivided = approx.stats.presubdivided;
+    result.stats.patches = approx.stats.patches;
+    result.stats.patchTable = approx.stats.patchTable;
     result.warnings.insert(result.warnings.end(), approx.warnings.begin(), approx.warnings.end());
     result.timings.approxMs = approx.approxMs;
     result.timings.rasterMs = drawing->rasterMs;

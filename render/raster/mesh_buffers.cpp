@@ -18,6 +18,7 @@ static_assert(sizeof(Vec2f) == 2 * sizeof(float), "Vec2f must be two packed floa
 constexpr GLuint kPositionAttribute = 0;
 constexpr GLuint kNormalAttribute = 1;
 constexpr GLuint kTexcoordAttribute = 2;
+constexpr GLuint kAlbedoAttribute = 3;
 
 void checkIndices(const std::vector<uint32_t>& indices, size_t groupSize, size_t vertexCount,
                   const char* what) {
@@ -54,13 +55,14 @@ void describePositions(GLuint array, GLuint positions) {
 }  // namespace
 
 MeshBuffers::MeshBuffers() {
-  GLuint buffers[5];
-  glCreateBuffers(5, buffers);
+  GLuint buffers[6];
+  glCreateBuffers(6, buffers);
   positions_ = buffers[0];
   normals_ = buffers[1];
   triangleIndices_ = buffers[2];
   lineIndices_ = buffers[3];
   texcoords_ = buffers[4];
+  albedo_ = buffers[5];
   glCreateVertexArrays(1, &triangleArray_);
   glCreateVertexArrays(1, &lineArray_);
 
@@ -71,6 +73,9 @@ MeshBuffers::MeshBuffers() {
   glVertexArrayVertexBuffer(triangleArray_, kTexcoordAttribute, texcoords_, 0, sizeof(Vec2f));
   glVertexArrayAttribFormat(triangleArray_, kTexcoordAttribute, 2, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(triangleArray_, kTexcoordAttribute, kTexcoordAttribute);
+  glVertexArrayVertexBuffer(triangleArray_, kAlbedoAttribute, albedo_, 0, sizeof(Vec3f));
+  glVertexArrayAttribFormat(triangleArray_, kAlbedoAttribute, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(triangleArray_, kAlbedoAttribute, kAlbedoAttribute);
   glVertexArrayElementBuffer(triangleArray_, triangleIndices_);
 
   describePositions(lineArray_, positions_);
@@ -81,8 +86,8 @@ MeshBuffers::MeshBuffers() {
 MeshBuffers::~MeshBuffers() {
   GLuint arrays[2] = {triangleArray_, lineArray_};
   glDeleteVertexArrays(2, arrays);
-  GLuint buffers[5] = {positions_, normals_, triangleIndices_, lineIndices_, texcoords_};
-  glDeleteBuffers(5, buffers);
+  GLuint buffers[6] = {positions_, normals_, triangleIndices_, lineIndices_, texcoords_, albedo_};
+  glDeleteBuffers(6, buffers);
 }
 
 void MeshBuffers::upload(const tessellate::TriangleMesh& mesh, bool withTexcoords) {
@@ -97,6 +102,11 @@ void MeshBuffers::upload(const tessellate::TriangleMesh& mesh, bool withTexcoord
     throw std::invalid_argument("raster: " + std::to_string(mesh.texcoords.size()) +
                                 " texture coordinates for " + std::to_string(vertexCount) +
                                 " vertices");
+  }
+
+  if (!mesh.albedo.empty() && mesh.albedo.size() != vertexCount) {
+    throw std::invalid_argument("raster: " + std::to_string(mesh.albedo.size()) +
+                                " albedo colours for " + std::to_string(vertexCount) + " vertices");
   }
 
   fill(positions_, mesh.positions);
@@ -117,6 +127,14 @@ void MeshBuffers::upload(const tessellate::TriangleMesh& mesh, bool withTexcoord
   } else {
     glDisableVertexArrayAttrib(triangleArray_, kTexcoordAttribute);
     glVertexAttrib2f(kTexcoordAttribute, 0.0f, 0.0f);
+  }
+  if (!mesh.albedo.empty()) {
+    fill(albedo_, mesh.albedo);
+    glEnableVertexArrayAttrib(triangleArray_, kAlbedoAttribute);
+  } else {
+    // A negative albedo makes the fragment shader use the front albedo.
+    glDisableVertexArrayAttrib(triangleArray_, kAlbedoAttribute);
+    glVertexAttrib3f(kAlbedoAttribute, -1.0f, -1.0f, -1.0f);
   }
   triangleIndexCount_ = static_cast<GLsizei>(mesh.indices.size());
   lineIndexCount_ = static_cast<GLsizei>(mesh.lines.size());

@@ -16,8 +16,9 @@ class MeshBuffers {
   MeshBuffers& operator=(const MeshBuffers&) = delete;
 
   // Uploads positions, normals (when there is one per vertex), texture coordinates (when
-  // `withTexcoords` and there is one per vertex), triangle indices and edges. Throws
-  // std::invalid_argument for indices out of range or mismatched array sizes.
+  // `withTexcoords` and there is one per vertex), albedo colours (when there is one per vertex),
+  // triangle indices and edges. Throws std::invalid_argument for indices out of range or mismatched
+  // array sizes.
   void upload(const tessellate::TriangleMesh& mesh, bool withTexcoords);
 
   bool hasNormals() const { return hasNormals_; }
@@ -27,7 +28,8 @@ class MeshBuffers {
 
  private:
   GLuint triangleArray_ = 0, lineArray_ = 0;
-  GLuint positions_ = 0, normals_ = 0, texcoords_ = 0, triangleIndices_ = 0, lineIndices_ = 0;
+  GLuint positions_ = 0, normals_ = 0, texcoords_ = 0, albedo_ = 0, triangleIndices_ = 0,
+         lineIndices_ = 0;
   GLsizei triangleIndexCount_ = 0, lineIndexCount_ = 0;
   bool hasNormals_ = false;
 };

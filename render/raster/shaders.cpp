@@ -37,17 +37,20 @@ std::string surfaceVertexShader() {
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec2 aTexcoord;
+layout(location = 3) in vec3 aAlbedo;  // negative: the front albedo
 uniform mat4 uViewProjection;
 uniform vec3 uEye;
 uniform vec3 uForward;
 out vec3 vFromEye;  // p - eye: small numbers near the eye keep the face normal precise
 out vec3 vNormal;
 out vec2 vTexcoord;
+out vec3 vAlbedo;
 out float vDepth;   // affine in p, so perspective-correct interpolation makes it exact
 void main() {
   vFromEye = aPosition - uEye;
   vNormal = aNormal;
   vTexcoord = aTexcoord;
+  vAlbedo = aAlbedo;
   vDepth = dot(vFromEye, uForward);
   gl_Position = uViewProjection * vec4(aPosition, 1.0);
 }
@@ -59,6 +62,7 @@ std::string surfaceFragmentShader() {
 in vec3 vFromEye;
 in vec3 vNormal;
 in vec2 vTexcoord;
+in vec3 vAlbedo;
 in float vDepth;
 uniform vec3 uForward;
 uniform bool uPerspective;
@@ -92,7 +96,8 @@ void main() {
 
   // shading::shade(): headlight Blinn-Phong, the half vector is toEye.
   float ndotv = dot(n, toEye);
-  vec3 albedo = ndotv >= 0.0 ? kFrontAlbedo : kBackAlbedo;
+  vec3 front = vAlbedo.x >= 0.0 ? vAlbedo : kFrontAlbedo;
+  vec3 albedo = ndotv >= 0.0 ? front : kBackAlbedo;
   float c = abs(ndotv);
   float spec = pow(c, kShininess);
   vec3 rgb = clamp(albedo * (kAmbient + kDiffuse * c) + kSpecular * spec, 0.0, 1.0);

@@ -39,6 +39,10 @@ struct TriangleMesh {
   std::vector<Vec2f> texcoords;
   std::shared_ptr<const Image> normalMap;
 
+  // Per-vertex front-face albedo in [0, 1] (the "patches" image colours each patch); empty:
+  // shading's front albedo. Back faces keep the back albedo either way.
+  std::vector<Vec3f> albedo;
+
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size(); }
 };

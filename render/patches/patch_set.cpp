@@ -1,0 +1,227 @@
+#include "render/patches/patch_set.h"
+
+#include <opensubdiv/bfr/parameterization.h>
+#include <opensubdiv/far/patchTableFactory.h>
+#include <opensubdiv/far/ptexIndices.h>
+#include <opensubdiv/far/stencilTableFactory.h>
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+#include "render/subdiv/far_point.h"
+#include "render/subdiv/limit_surface.h"
+
+namespace limn::render::patches {
+
+namespace Far = OpenSubdiv::Far;
+
+namespace {
+
+// The most points a patch has (a quad Gregory basis patch).
+constexpr int kMaxPatchPoints = 20;
+
+// Options shared with Bfr's own patch trees (and subdiv::FarPatchSurface): infinitely sharp
+// features as patches, Gregory bases for what stays irregular, smooth corners kept smooth.
+Far::PatchTableFactory::Options tableOptions(int isolation) {
+  Far::PatchTableFactory::Options options(isolation);
+  options.SetEndCapType(Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
+  options.useInfSharpPatch = true;
+  options.useSingleCreasePatch = false;
+  options.generateLegacySharpCornerPatches = false;
+  options.generateVaryingTables = false;
+  options.generateVaryingLocalPoints = false;
+  options.SetPatchPrecision<double>();
+  return options;
+}
+
+// Stencils from the control points to every refined point, then to every end-cap point.
+std::unique_ptr<const Far::StencilTableReal<double>> pointStencils(
+    const Far::TopologyRefiner& refiner, const Far::PatchTable& table) {
+  using Factory = Far::StencilTableFactoryReal<double>;
+  Factory::Options options;
+  options.generateIntermediateLevels = true;
+  options.factorizeIntermediateLevels = true;
+  options.generateOffsets = true;
+  std::unique_ptr<const Far::StencilTableReal<double>> refined(Factory::Create(refiner, options));
+  const Far::StencilTableReal<double>* endCaps = table.GetLocalPointStencilTable<double>();
+  if (endCaps == nullptr || endCaps->GetNumStencils() == 0) return refined;
+  return std::unique_ptr<const Far::StencilTableReal<double>>(
+      Factory::AppendLocalPointStencilTable(refiner, refined.get(), endCaps));
+}
+
+std::vector<bool> facesOnTheBoundary(const Far::TopologyLevel& base) {
+  std::vector<bool> out(base.GetNumFaces(), false);
+  for (int f = 0; f < base.GetNumFaces(); ++f) {
+    for (int e : base.GetFaceEdges(f)) {
+      if (base.IsEdgeBoundary(e) || base.IsEdgeNonManifold(e)) out[f] = true;
+    }
+  }
+  return out;
+}
+
+PatchKind kindOf(Far::PatchDescriptor::Type type, const Far::PatchParam& param,
+                 bool onBoundary) {
+  if (type != Far::PatchDescriptor::REGULAR && type != Far::PatchDescriptor::LOOP) {
+    return PatchKind::Irregular;
+  }
+  if (param.GetBoundary() == 0) return PatchKind::Regular;
+  return onBoundary ? PatchKind::Boundary : PatchKind::Crease;
+}
+
+}  // namespace
+
+const char* patchKindName(PatchKind kind) {
+  switch (kind) {
+    case PatchKind::Regular:
+      return "regular";
+    case PatchKind::Boundary:
+      return "boundary";
+    case PatchKind::Crease:
+      return "crease";
+    case PatchKind::Irregular:
+      return "irregular";
+  }
+  return "?";
+}
+
+PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel)
+    : scheme_(mesh.scheme), controlPoints_(mesh.points.size()) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<Far::TopologyRefiner> refiner = subdiv::createTopologyRefiner(mesh);
+  const Far::TopologyLevel& base = refiner->GetLevel(0);
+  const std::vector<bool> onBoundary = facesOnTheBoundary(base);
+  closed_ = std::none_of(onBoundary.begin(), onBoundary.end(), [](bool b) { return b; });
+  for (int f = 0; f < base.GetNumFaces(); ++f) closed_ = closed_ && !base.IsFaceHole(f);
+  // Ptex faces (one per quad or triangle, one per corner of an n-gon) back to base faces.
+  std::vector<std::pair<int, int>> ptexToFace;
+  {
+    Far::PtexIndices ptex(*refiner);
+    for (int f = 0; f < base.GetNumFaces(); ++f) {
+      const int first = ptex.GetFaceId(f);
+      const int count = (f + 1 < base.GetNumFaces() ? ptex.GetFaceId(f + 1) : ptex.GetNumFaces()) -
+                        first;
+      for (int k = 0; k < count; ++k) ptexToFace.push_back({f, count > 1 ? k : -1});
+    }
+  }
+  cancel.check();
+
+  Far::PatchTableFactory::Options options = tableOptions(isolation);
+  Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
+  adaptive.secondaryLevel = isolation;
+  refiner->RefineAdaptive(adaptive);
+  cancel.check();
+  table_.reset(Far::PatchTableFactory::Create(*refiner, options));
+  cancel.check();
+  stencils_ = pointStencils(*refiner, *table_);
+  cancel.check();
+
+  stats_.isolation = isolation;
+  stats_.refinedPoints = refiner->GetNumVerticesTotal() - controlPoints_;
+  stats_.endCapPoints = table_->GetNumLocalPoints();
+  for (int a = 0; a < table_->GetNumPatchArrays(); ++a) {
+    const Far::PatchDescriptor descriptor = table_->GetPatchArrayDescriptor(a);
+    if (descriptor.GetNumControlVertices() > kMaxPatchPoints) {
+      throw std::logic_error("Far built a patch type with more points than expected");
+    }
+    const bool triangle = descriptor.GetType() == Far::PatchDescriptor::LOOP ||
+                          descriptor.GetType() == Far::PatchDescriptor::GREGORY_TRIANGLE;
+    for (int i = 0; i < table_->GetNumPatches(a); ++i) {
+      Patch patch;
+      patch.param = table_->GetPatchParam(a, i);
+      patch.handle.arrayIndex = a;
+      patch.handle.patchIndex = static_cast<int>(patches_.size());
+      patch.handle.vertIndex = i * descriptor.GetNumControlVertices();
+      const auto [face, subFace] = ptexToFace.at(patch.param.GetFaceId());
+      patch.baseFace = face;
+      patch.subFace = subFace;
+      patch.faceSize = base.GetFaceVertices(face).size();
+      patch.depth = patch.param.GetDepth();
+      patch.kind = kindOf(descriptor.GetType(), patch.param, onBoundary[face]);
+      patch.triangle = triangle;
+      patch.inHull = patch.param.GetBoundary() == 0;
+      patch.cullable = descriptor.GetType() == Far::PatchDescriptor::REGULAR && patch.inHull;
+      if (static_cast<int>(stats_.byLevel.size()) <= patch.depth) {
+        stats_.byLevel.resize(patch.depth + 1, {});
+      }
+      ++stats_.byLevel[patch.depth][static_cast<int>(patch.kind)];
+      patches_.push_back(patch);
+    }
+  }
+  stats_.patches = patches_.size();
+  setControlPoints(mesh.points);
+  stats_.buildMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+PatchSet::~PatchSet() = default;
+
+void PatchSet::setControlPoints(const std::vector<Vec3>& points) {
+  if (points.size() != controlPoints_) {
+    throw std::invalid_argument("a frame has " + std::to_string(points.size()) +
+                                " points; the mesh has " + std::to_string(controlPoints_));
+  }
+  std::vector<subdiv::FarPoint> buffer(controlPoints_ + (stencils_ ? stencils_->GetNumStencils()
+                                                                   : 0));
+  for (size_t i = 0; i < controlPoints_; ++i) buffer[i].p = points[i];
+  if (stencils_ && stencils_->GetNumStencils() > 0) {
+    stencils_->UpdateValues(buffer.data(), buffer.data() + controlPoints_);
+  }
+  controlBounds_ = Bounds{};
+  for (const Vec3& p : points) controlBounds_.extend(p);
+  points_.resize(buffer.size());
+  for (size_t i = 0; i < buffer.size(); ++i) points_[i] = buffer[i].p;
+}
+
+Vec2 PatchSet::toPtex(const Patch& patch, double s, double t) const {
+  if (patch.triangle) {
+    patch.param.UnnormalizeTriangle(s, t);
+  } else {
+    patch.param.Unnormalize(s, t);
+  }
+  return {s, t};
+}
+
+Vec2 PatchSet::toFaceUV(const Patch& patch, double s, double t) const {
+  const Vec2 ptex = toPtex(patch, s, t);
+  if (patch.subFace < 0) return ptex;
+  const OpenSubdiv::Bfr::Parameterization param(
+      scheme_ == mesh::Scheme::Loop ? OpenSubdiv::Sdc::SCHEME_LOOP
+                                    : OpenSubdiv::Sdc::SCHEME_CATMARK,
+      patch.faceSize);
+  double st[2] = {ptex.x, ptex.y}, uv[2];
+  param.ConvertNormalizedSubFaceToCoord(patch.subFace, st, uv);
+  return {uv[0], uv[1]};
+}
+
+void PatchSet::evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds,
+                        Vec3& dt) const {
+  const Vec2 at = toPtex(patch, s, t);
+  std::array<double, kMaxPatchPoints> w, wDs, wDt;
+  table_->EvaluateBasis(patch.handle, at.x, at.y, w.data(), wDs.data(), wDt.data());
+  Far::ConstIndexArray cvs = table_->GetPatchVertices(patch.handle);
+  position = ds = dt = Vec3{0, 0, 0};
+  for (int i = 0; i < cvs.size(); ++i) {
+    const Vec3& p = points_[cvs[i]];
+    position += p * w[i];
+    ds += p * wDs[i];
+    dt += p * wDt[i];
+  }
+}
+
+std::vector<Vec3> PatchSet::controlPoints(const Patch& patch) const {
+  std::vector<Vec3> out;
+  for (int index : table_->GetPatchVertices(patch.handle)) out.push_back(points_[index]);
+  return out;
+}
+
+std::array<Vec3, 16> PatchSet::bsplinePoints(const Patch& patch) const {
+  Far::ConstIndexArray cvs = table_->GetPatchVertices(patch.handle);
+  if (cvs.size() != 16) throw std::logic_error("not a regular bicubic patch");
+  std::array<Vec3, 16> out;
+  for (int i = 0; i < 16; ++i) out[i] = points_[cvs[i]];
+  return out;
+}
+
+}  // namespace limn::render::patches

@@ -1,0 +1,108 @@
+// PatchSet: a control mesh as OpenSubdiv's feature-adaptive patches (Far::PatchTable).
+//
+// Far refines the mesh only around what is not a regular B-spline (Catmull-Clark) or box-spline
+// (Loop) patch: extraordinary vertices, semi-sharp creases, irregular boundaries. Each level of
+// isolation halves the irregular region, so the patch count grows with the mesh's features,
+// not 4x per level as uniform refinement does. What stays irregular at the isolation level is
+// closed by Gregory end caps. Infinitely sharp edges become patch boundaries.
+//
+// The topology, refiner, patch table and the stencils that map control points to every patch
+// point are built once; setControlPoints() re-evaluates only the points (animation frames).
+#pragma once
+
+#include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/stencilTable.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "render/core/cancel.h"
+#include "render/core/vec.h"
+#include "render/mesh/control_mesh.h"
+
+namespace limn::render::patches {
+
+// What a patch is, for stats and the "patches" image: a regular B-spline / box-spline patch,
+// one bounded by a mesh boundary, one bounded by an infinitely sharp crease, or an irregular
+// Gregory end cap.
+enum class PatchKind { Regular, Boundary, Crease, Irregular };
+inline constexpr int kPatchKinds = 4;
+const char* patchKindName(PatchKind kind);
+
+// The isolation "auto" picks, and the most a request may ask for.
+inline constexpr int kDefaultIsolation = 4;
+inline constexpr int kMaxIsolation = 8;
+
+struct Patch {
+  OpenSubdiv::Far::PatchTable::PatchHandle handle;
+  OpenSubdiv::Far::PatchParam param;
+  int baseFace = 0;
+  int subFace = -1;  // the Ptex sub-face of a Catmull-Clark n-gon, -1 for quads and triangles
+  int faceSize = 4;  // corners of the base face
+  int depth = 0;     // refinement level of the patch (0: a regular base face)
+  PatchKind kind = PatchKind::Regular;
+  bool triangle = false;   // Loop: the unit triangle; Catmull-Clark: the unit square
+  bool cullable = false;   // a regular patch without boundary: its 4 x 4 points bound it
+  // Its points are convex combinations of its control points (every patch but those with a
+  // boundary edge, whose extrapolated phantom points give some points negative weights).
+  bool inHull = false;
+};
+
+struct PatchTableStats {
+  int isolation = 0;
+  size_t patches = 0;
+  // Patches per depth (index) and kind (regular, boundary, crease, irregular).
+  std::vector<std::array<size_t, kPatchKinds>> byLevel;
+  size_t refinedPoints = 0, endCapPoints = 0;
+  double buildMs = 0;
+};
+
+class PatchSet {
+ public:
+  // Throws InputError(InvalidMesh) when OpenSubdiv rejects the topology; checks `cancel`
+  // between the stages.
+  PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel);
+  ~PatchSet();
+  PatchSet(const PatchSet&) = delete;
+  PatchSet& operator=(const PatchSet&) = delete;
+
+  // New positions of the same control points (one animation frame): refined and end-cap points
+  // are recomputed from the stencils, nothing else. Throws std::invalid_argument on a size
+  // mismatch.
+  void setControlPoints(const std::vector<Vec3>& points);
+
+  const std::vector<Patch>& patches() const { return patches_; }
+  const PatchTableStats& stats() const { return stats_; }
+  mesh::Scheme scheme() const { return scheme_; }
+  // No boundary, non-manifold edge or hole: seen from outside, back-facing patches are hidden.
+  bool closed() const { return closed_; }
+  // The control points' bounds, which hold the whole surface (its points are convex
+  // combinations of them).
+  const Bounds& controlBounds() const { return controlBounds_; }
+
+  // Position and first derivatives at patch-local (s, t): [0,1]^2, or the unit triangle.
+  void evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds,
+                Vec3& dt) const;
+  // The patch's local (s, t) in its Ptex face's coordinates (a sub-face's for n-gons).
+  Vec2 toPtex(const Patch& patch, double s, double t) const;
+  // The patch's local (s, t) as Bfr's (u, v) on its base face (subdiv::LimitSurface's).
+  Vec2 toFaceUV(const Patch& patch, double s, double t) const;
+  // The patch's control points (any type).
+  std::vector<Vec3> controlPoints(const Patch& patch) const;
+  // A regular patch's 4 x 4 B-spline points, row by row (s runs along a row).
+  std::array<Vec3, 16> bsplinePoints(const Patch& patch) const;
+
+ private:
+  mesh::Scheme scheme_;
+  bool closed_ = false;
+  Bounds controlBounds_;
+  size_t controlPoints_ = 0;
+  std::unique_ptr<OpenSubdiv::Far::PatchTable> table_;
+  std::unique_ptr<const OpenSubdiv::Far::StencilTableReal<double>> stencils_;
+  std::vector<Vec3> points_;  // control, refined and end-cap points, as the table indexes them
+  std::vector<Patch> patches_;
+  PatchTableStats stats_;
+};
+
+}  // namespace limn::render::patches

@@ -1,0 +1,548 @@
+#include "render/patches/patch_tessellation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <string>
+#include <unordered_map>
+
+#include "render/core/error.h"
+#include "render/core/parallel.h"
+
+namespace limn::render::patches {
+
+namespace {
+
+constexpr int kPatchesBetweenChecks = 256;
+// Patch corners closer than this (times the bounding diagonal) are one vertex: the same limit
+// point evaluated on two patches differs by rounding only.
+constexpr double kWeldTolerance = 1e-7;
+// Far's neighbours differ by one level; deeper splits are only followed this far.
+constexpr int kMaxSplitDepth = 4;
+
+// Points within `tolerance` of each other, found through a grid of cells of that size.
+class Welder {
+ public:
+  Welder(const std::vector<Vec3>& points, double tolerance)
+      : points_(points), cell_(tolerance), tolerance2_(tolerance * tolerance) {}
+
+  int find(const Vec3& p) const {
+    const std::array<int64_t, 3> c = cellOf(p);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto it = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+          if (it == cells_.end()) continue;
+          for (int id : it->second) {
+            const Vec3 d = points_[id] - p;
+            if (dot(d, d) <= tolerance2_) return id;
+          }
+        }
+      }
+    }
+    return -1;
+  }
+  void add(int id) { cells_[key(cellOf(points_[id]))].push_back(id); }
+
+ private:
+  std::array<int64_t, 3> cellOf(const Vec3& p) const {
+    return {static_cast<int64_t>(std::floor(p.x / cell_)),
+            static_cast<int64_t>(std::floor(p.y / cell_)),
+            static_cast<int64_t>(std::floor(p.z / cell_))};
+  }
+  static uint64_t key(const std::array<int64_t, 3>& c) {
+    return (static_cast<uint64_t>(c[0]) * 73856093u) ^ (static_cast<uint64_t>(c[1]) * 19349663u) ^
+           (static_cast<uint64_t>(c[2]) * 83492791u);
+  }
+
+  const std::vector<Vec3>& points_;
+  double cell_, tolerance2_;
+  std::unordered_map<uint64_t, std::vector<int>> cells_;
+};
+
+Vec2 lerp(Vec2 a, Vec2 b, double t) { return {a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t}; }
+
+constexpr std::array<Vec2, 4> kQuadCorners = {Vec2{0, 0}, Vec2{1, 0}, Vec2{1, 1}, Vec2{0, 1}};
+constexpr std::array<Vec2, 3> kTriangleCorners = {Vec2{0, 0}, Vec2{1, 0}, Vec2{0, 1}};
+
+int cornerCount(const Patch& patch) { return patch.triangle ? 3 : 4; }
+Vec2 corner(const Patch& patch, int k) {
+  return patch.triangle ? kTriangleCorners[k] : kQuadCorners[k];
+}
+
+struct Sample {
+  Vec3 position, normal;
+};
+
+// The unit normal at (s, t); where the derivatives vanish (some end-cap corners), the normal a
+// little way towards the patch centre.
+Sample evaluateSample(const PatchSet& set, const Patch& patch, Vec2 st) {
+  Sample out;
+  Vec3 ds, dt;
+  set.evaluate(patch, st.x, st.y, out.position, ds, dt);
+  Vec3 n = cross(ds, dt);
+  const Vec2 centre = patch.triangle ? Vec2{1.0 / 3, 1.0 / 3} : Vec2{0.5, 0.5};
+  for (double step = 1e-4; length(n) <= 1e-12 * length(ds) * length(dt) && step < 0.5;
+       step *= 10) {
+    Vec3 ignored;
+    const Vec2 in = lerp(st, centre, step);
+    set.evaluate(patch, in.x, in.y, ignored, ds, dt);
+    n = cross(ds, dt);
+  }
+  const double len = length(n);
+  out.normal = len > 0 ? n / len : Vec3{0, 0, 1};
+  return out;
+}
+
+// One piece of a patch edge between two welded vertices, in the patch's local coordinates.
+struct Piece {
+  int from, to;
+  Vec2 a, b;
+};
+
+// What the inside of one patch becomes. Triangle corners are vertex ids when >= 0, and
+// ~k for the patch's k-th interior point.
+struct PatchInside {
+  std::vector<Vec2> interior;
+  std::vector<Sample> samples;
+  std::vector<int> triangles;
+  std::vector<Vec2> cornerLocal;  // local (s, t) of each triangle corner
+};
+
+// One side of the ring: outer points (ids, from corner to corner) zipped to the inner ones.
+void zip(const std::vector<int>& outer, const std::vector<Vec2>& outerAt,
+         const std::vector<int>& inner, const std::vector<Vec2>& innerAt, PatchInside& out) {
+  const size_t m = outer.size() - 1, n = inner.size() - 1;
+  size_t a = 0, b = 0;
+  auto emit = [&](int i0, Vec2 l0, int i1, Vec2 l1, int i2, Vec2 l2) {
+    out.triangles.insert(out.triangles.end(), {i0, i1, i2});
+    out.cornerLocal.insert(out.cornerLocal.end(), {l0, l1, l2});
+  };
+  while (a < m || b < n) {
+    const bool advanceOuter =
+        b == n || (a < m && (a + 0.5) / static_cast<double>(m) <= (b + 0.5) / static_cast<double>(n));
+    if (advanceOuter) {
+      emit(outer[a], outerAt[a], outer[a + 1], outerAt[a + 1], inner[b], innerAt[b]);
+      ++a;
+    } else {
+      emit(outer[a], outerAt[a], inner[b + 1], innerAt[b + 1], inner[b], innerAt[b]);
+      ++b;
+    }
+  }
+}
+
+// Ring sides: each side's outer points (corner to corner) and their local coordinates.
+struct Ring {
+  std::vector<std::vector<int>> ids;
+  std::vector<std::vector<Vec2>> at;
+  int segments(int side) const { return static_cast<int>(ids[side].size()) - 1; }
+};
+
+void tessellateQuadInside(const Ring& ring, int maxFactor, PatchInside& out) {
+  const std::array<int, 4> seg = {ring.segments(0), ring.segments(1), ring.segments(2),
+                                  ring.segments(3)};
+  if (seg == std::array<int, 4>{1, 1, 1, 1}) {
+    const int c0 = ring.ids[0][0], c1 = ring.ids[1][0], c2 = ring.ids[2][0], c3 = ring.ids[3][0];
+    out.triangles = {c0, c1, c2, c0, c2, c3};
+    out.cornerLocal = {kQuadCorners[0], kQuadCorners[1], kQuadCorners[2],
+                       kQuadCorners[0], kQuadCorners[2], kQuadCorners[3]};
+    return;
+  }
+  const int iu = std::clamp(std::max(seg[0], seg[2]), 2, maxFactor);
+  const int iv = std::clamp(std::max(seg[1], seg[3]), 2, maxFactor);
+  auto interiorId = [&](int i, int j) { return ~((j - 1) * (iu - 1) + (i - 1)); };
+  auto at = [&](int i, int j) { return Vec2{static_cast<double>(i) / iu, static_cast<double>(j) / iv}; };
+  for (int j = 1; j < iv; ++j) {
+    for (int i = 1; i < iu; ++i) out.interior.push_back(at(i, j));
+  }
+  for (int j = 1; j + 1 < iv; ++j) {
+    for (int i = 1; i + 1 < iu; ++i) {
+      const int a = interiorId(i, j), b = interiorId(i + 1, j), c = interiorId(i + 1, j + 1),
+                d = interiorId(i, j + 1);
+      out.triangles.insert(out.triangles.end(), {a, b, c, a, c, d});
+      out.cornerLocal.insert(out.cornerLocal.end(),
+                             {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1),
+                              at(i, j + 1)});
+    }
+  }
+  // The inner ring's sides, in the same turning order as the outer ones.
+  std::array<std::vector<std::array<int, 2>>, 4> sides;
+  for (int i = 1; i < iu; ++i) sides[0].push_back({i, 1});
+  for (int j = 1; j < iv; ++j) sides[1].push_back({iu - 1, j});
+  for (int i = iu - 1; i >= 1; --i) sides[2].push_back({i, iv - 1});
+  for (int j = iv - 1; j >= 1; --j) sides[3].push_back({1, j});
+  for (int k = 0; k < 4; ++k) {
+    std::vector<int> ids;
+    std::vector<Vec2> local;
+    for (auto [i, j] : sides[k]) {
+      ids.push_back(interiorId(i, j));
+      local.push_back(at(i, j));
+    }
+    zip(ring.ids[k], ring.at[k], ids, local, out);
+  }
+}
+
+void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out) {
+  const std::array<int, 3> seg = {ring.segments(0), ring.segments(1), ring.segments(2)};
+  if (seg == std::array<int, 3>{1, 1, 1}) {
+    out.triangles = {ring.ids[0][0], ring.ids[1][0], ring.ids[2][0]};
+    out.cornerLocal = {kTriangleCorners[0], kTriangleCorners[1], kTriangleCorners[2]};
+    return;
+  }
+  const int n = std::clamp(std::max({seg[0], seg[1], seg[2]}), 3, maxFactor);
+  // Interior points (i, j), i, j >= 1, i + j <= n - 1, numbered row by row.
+  std::vector<int> rowStart(n, 0);
+  int count = 0;
+  for (int j = 1; j <= n - 2; ++j) {
+    rowStart[j] = count;
+    count += n - 1 - j;
+  }
+  auto interiorId = [&](int i, int j) { return ~(rowStart[j] + (i - 1)); };
+  auto at = [&](int i, int j) { return Vec2{static_cast<double>(i) / n, static_cast<double>(j) / n}; };
+  for (int j = 1; j <= n - 2; ++j) {
+    for (int i = 1; i + j <= n - 1; ++i) out.interior.push_back(at(i, j));
+  }
+  for (int j = 1; j <= n - 2; ++j) {
+    for (int i = 1; i + j <= n - 2; ++i) {
+      out.triangles.insert(out.triangles.end(),
+                           {interiorId(i, j), interiorId(i + 1, j), interiorId(i, j + 1)});
+      out.cornerLocal.insert(out.cornerLocal.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
+      if (i + j <= n - 3) {
+        out.triangles.insert(out.triangles.end(), {interiorId(i + 1, j), interiorId(i + 1, j + 1),
+                                                   interiorId(i, j + 1)});
+        out.cornerLocal.insert(out.cornerLocal.end(), {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+    }
+  }
+  std::array<std::vector<std::array<int, 2>>, 3> sides;
+  for (int i = 1; i <= n - 2; ++i) sides[0].push_back({i, 1});
+  for (int j = 1; j <= n - 2; ++j) sides[1].push_back({n - 1 - j, j});
+  for (int j = n - 2; j >= 1; --j) sides[2].push_back({1, j});
+  for (int k = 0; k < 3; ++k) {
+    std::vector<int> ids;
+    std::vector<Vec2> local;
+    for (auto [i, j] : sides[k]) {
+      ids.push_back(interiorId(i, j));
+      local.push_back(at(i, j));
+    }
+    zip(ring.ids[k], ring.at[k], ids, local, out);
+  }
+}
+
+// Triangles the inside of a patch will make (checked against the budget before evaluating).
+size_t insideTriangles(const Patch& patch, const Ring& ring, int maxFactor) {
+  int most = 1, sum = 0;
+  for (size_t k = 0; k < ring.ids.size(); ++k) {
+    most = std::max(most, ring.segments(static_cast<int>(k)));
+    sum += ring.segments(static_cast<int>(k));
+  }
+  if (most == 1) return patch.triangle ? 1 : 2;
+  const size_t n = std::min(most, maxFactor);
+  return (patch.triangle ? n * n : 2 * n * n) + sum;
+}
+
+class Tessellator {
+ public:
+  Tessellator(const PatchSet& set, const Camera& camera, const TessellationOptions& options,
+              const CancelToken& cancel)
+      : set_(set),
+        camera_(camera),
+        options_(options),
+        cancel_(cancel),
+        welder_(positions_, kWeldTolerance * std::max(set.controlBounds().diagonal(), 1e-300)) {}
+
+  PatchMesh run() {
+    const std::vector<Patch>& patches = set_.patches();
+    weldCorners();
+    chooseCulled();
+    std::vector<Ring> rings(patches.size());
+    size_t triangles = 0;
+    for (size_t p = 0; p < patches.size(); ++p) {
+      if (p % kPatchesBetweenChecks == 0) cancel_.check();
+      if (culled_[p]) continue;
+      rings[p] = ringOf(p);
+      triangles += insideTriangles(patches[p], rings[p], options_.maxEdgeFactor);
+    }
+    if (triangles > options_.maxTriangles) {
+      throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
+                       "patches tessellation would make " + std::to_string(triangles) +
+                           " triangles: exceeds limit maxTriangles " +
+                           std::to_string(options_.maxTriangles) + " (raise params.dicingRate)");
+    }
+    std::vector<PatchInside> insides(patches.size());
+    parallelFor(patches.size(), 64, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        if (p % kPatchesBetweenChecks == 0) cancel_.check();
+        if (culled_[p]) continue;
+        PatchInside& in = insides[p];
+        if (patches[p].triangle) {
+          tessellateTriangleInside(rings[p], options_.maxEdgeFactor, in);
+        } else {
+          tessellateQuadInside(rings[p], options_.maxEdgeFactor, in);
+        }
+        in.samples.reserve(in.interior.size());
+        for (const Vec2& st : in.interior) in.samples.push_back(evaluateSample(set_, patches[p], st));
+      }
+    });
+    cancel_.check();
+    return assemble(insides);
+  }
+
+ private:
+  int addVertex(const Sample& s) {
+    positions_.push_back(s.position);
+    normals_.push_back(s.normal);
+    return static_cast<int>(positions_.size()) - 1;
+  }
+
+  void weldCorners() {
+    const std::vector<Patch>& patches = set_.patches();
+    std::vector<std::array<Sample, 4>> samples(patches.size());
+    parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        for (int k = 0; k < cornerCount(patches[p]); ++k) {
+          samples[p][k] = evaluateSample(set_, patches[p], corner(patches[p], k));
+        }
+      }
+    });
+    corners_.assign(patches.size(), {-1, -1, -1, -1});
+    for (size_t p = 0; p < patches.size(); ++p) {
+      for (int k = 0; k < cornerCount(patches[p]); ++k) {
+        int id = welder_.find(samples[p][k].position);
+        if (id < 0) {
+          id = addVertex(samples[p][k]);
+          welder_.add(id);
+        }
+        corners_[p][k] = id;
+      }
+    }
+  }
+
+  void chooseCulled() {
+    const std::vector<Patch>& patches = set_.patches();
+    culled_.assign(patches.size(), 0);
+    if (!options_.cullHidden) return;
+    const bool backFacesHidden = set_.closed() && seenFromOutside();
+    // 1: outside the view, 2: facing away.
+    parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        if (outsideTheView(set_, patches[p], camera_)) {
+          culled_[p] = 1;
+        } else if (backFacesHidden && facesAwayEverywhere(set_, patches[p], camera_)) {
+          culled_[p] = 2;
+        }
+      }
+    });
+    stats_.patchesOffScreen = std::count(culled_.begin(), culled_.end(), uint8_t{1});
+    stats_.patchesCulled = std::count(culled_.begin(), culled_.end(), uint8_t{2});
+  }
+
+  // The eye outside the surface and nothing of it clipped by the near plane: then every ray
+  // meets a front-facing patch before any back-facing one.
+  bool seenFromOutside() const {
+    const Bounds& b = set_.controlBounds();
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 c{k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z};
+      if (camera_.depthOf(c) <= camera_.nearPlane()) return false;
+    }
+    return true;
+  }
+
+  // The edge from corner k to the next, cut where finer neighbours' corners lie on it.
+  void splitEdge(const Patch& patch, int from, int to, Vec2 a, Vec2 b, int depth,
+                 std::vector<Piece>& out) {
+    if (depth < kMaxSplitDepth) {
+      const Vec2 mid = lerp(a, b, 0.5);
+      Vec3 position, ds, dt;
+      set_.evaluate(patch, mid.x, mid.y, position, ds, dt);
+      const int m = welder_.find(position);
+      if (m >= 0 && m != from && m != to) {
+        splitEdge(patch, from, m, a, mid, depth + 1, out);
+        splitEdge(patch, m, to, mid, b, depth + 1, out);
+        return;
+      }
+    }
+    out.push_back({from, to, a, b});
+  }
+
+  // Segments of one piece: its projected length over the dicing rate, from the welded end
+  // points only, so both patches sharing the piece compute the same number. A piece crossing
+  // the eye plane is as fine as allowed.
+  int segmentsOf(const Piece& piece) {
+    const Vec3 a = camera_.project(positions_[piece.from]);
+    const Vec3 b = camera_.project(positions_[piece.to]);
+    double wanted = std::ceil(std::hypot(a.x - b.x, a.y - b.y) / options_.dicingRate);
+    if (camera_.projection() == Projection::Perspective) {
+      const bool aBehind = a.z <= camera_.nearPlane(), bBehind = b.z <= camera_.nearPlane();
+      if (aBehind && bBehind) wanted = 1;
+      if (aBehind != bBehind) wanted = options_.maxEdgeFactor;
+    }
+    if (wanted > options_.maxEdgeFactor) ++stats_.clampedEdges;
+    return static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options_.maxEdgeFactor)));
+  }
+
+  // The vertices strictly inside a piece, from `from` towards `to`; made by the first patch
+  // that needs them.
+  std::vector<int> pieceVertices(const Patch& patch, const Piece& piece) {
+    const bool forward = piece.from < piece.to;
+    const std::pair<int, int> key = std::minmax(piece.from, piece.to);
+    auto it = edgeVertices_.find(key);
+    if (it == edgeVertices_.end()) {
+      const int segments = segmentsOf(piece);
+      std::vector<int> ids;
+      for (int k = 1; k < segments; ++k) {
+        const double t = static_cast<double>(k) / segments;
+        const Vec2 st = forward ? lerp(piece.a, piece.b, t) : lerp(piece.b, piece.a, t);
+        ids.push_back(addVertex(evaluateSample(set_, patch, st)));
+      }
+      it = edgeVertices_.emplace(key, std::move(ids)).first;
+    }
+    std::vector<int> out = it->second;
+    if (!forward) std::reverse(out.begin(), out.end());
+    return out;
+  }
+
+  Ring ringOf(size_t p) {
+    const Patch& patch = set_.patches()[p];
+    const int n = cornerCount(patch);
+    Ring ring;
+    ring.ids.resize(n);
+    ring.at.resize(n);
+    for (int k = 0; k < n; ++k) {
+      const Vec2 a = corner(patch, k), b = corner(patch, (k + 1) % n);
+      std::vector<Piece> pieces;
+      splitEdge(patch, corners_[p][k], corners_[p][(k + 1) % n], a, b, 0, pieces);
+      if (pieces.size() > 1) ++stats_.transitionEdges;
+      for (const Piece& piece : pieces) {
+        ring.ids[k].push_back(piece.from);
+        ring.at[k].push_back(piece.a);
+        const std::vector<int> inside = pieceVertices(patch, piece);
+        for (size_t i = 0; i < inside.size(); ++i) {
+          ring.ids[k].push_back(inside[i]);
+          ring.at[k].push_back(lerp(piece.a, piece.b, (i + 1.0) / (inside.size() + 1.0)));
+        }
+      }
+      ring.ids[k].push_back(corners_[p][(k + 1) % n]);
+      ring.at[k].push_back(b);
+    }
+    return ring;
+  }
+
+  PatchMesh assemble(std::vector<PatchInside>& insides) {
+    const std::vector<Patch>& patches = set_.patches();
+    PatchMesh out;
+    tessellate::TriangleMesh& mesh = out.mesh;
+    for (size_t p = 0; p < patches.size(); ++p) {
+      if (culled_[p]) continue;
+      ++stats_.patchesDrawn;
+      PatchInside& in = insides[p];
+      const int first = static_cast<int>(positions_.size());
+      for (const Sample& s : in.samples) addVertex(s);
+      for (size_t c = 0; c < in.triangles.size(); ++c) {
+        const int id = in.triangles[c];
+        mesh.indices.push_back(static_cast<uint32_t>(id >= 0 ? id : first + ~id));
+        const Vec2 uv = set_.toFaceUV(patches[p], in.cornerLocal[c].x, in.cornerLocal[c].y);
+        mesh.cornerUVs.push_back(Vec2f{static_cast<float>(uv.x), static_cast<float>(uv.y)});
+      }
+      const size_t count = in.triangles.size() / 3;
+      mesh.triangleFaces.insert(mesh.triangleFaces.end(), count, patches[p].baseFace);
+      out.trianglePatch.insert(out.trianglePatch.end(), count, static_cast<int32_t>(p));
+      in = PatchInside{};
+    }
+    mesh.positions.reserve(positions_.size());
+    mesh.normals.reserve(normals_.size());
+    for (size_t i = 0; i < positions_.size(); ++i) {
+      mesh.positions.emplace_back(positions_[i]);
+      mesh.normals.emplace_back(normals_[i]);
+    }
+    out.stats = stats_;
+    return out;
+  }
+
+  const PatchSet& set_;
+  const Camera& camera_;
+  const TessellationOptions& options_;
+  const CancelToken& cancel_;
+  std::vector<Vec3> positions_, normals_;
+  Welder welder_;
+  std::vector<std::array<int, 4>> corners_;
+  std::vector<uint8_t> culled_;
+  std::map<std::pair<int, int>, std::vector<int>> edgeVertices_;
+  TessellationStats stats_;
+};
+
+}  // namespace
+
+bool outsideTheView(const PatchSet& set, const Patch& patch, const Camera& camera) {
+  if (!patch.inHull) return false;
+  const std::vector<Vec3> points = set.controlPoints(patch);
+  Vec3 centre{0, 0, 0};
+  for (const Vec3& q : points) centre += q / static_cast<double>(points.size());
+  double radius = 0;
+  for (const Vec3& q : points) radius = std::max(radius, length(q - centre));
+  // The sphere in camera space against the four side planes (and, in perspective, the eye
+  // plane): outside one of them entirely is outside the view.
+  const Vec3 d = centre - camera.eye();
+  const double x = dot(d, camera.right()), y = dot(d, camera.trueUp()), z = dot(d, camera.forward());
+  const double aspect = static_cast<double>(camera.width()) / camera.height();
+  if (camera.projection() == Projection::Orthographic) {
+    const double halfH = camera.orthoHeight() * 0.5, halfW = halfH * aspect;
+    return std::fabs(x) > halfW + radius || std::fabs(y) > halfH + radius;
+  }
+  if (z < -radius) return true;
+  const double tanY = std::tan(camera.fovYDeg() * std::numbers::pi / 360.0), tanX = tanY * aspect;
+  auto beyond = [&](double lateral, double tangent) {
+    return (std::fabs(lateral) - z * tangent) / std::sqrt(1 + tangent * tangent) > radius;
+  };
+  return beyond(x, tanX) || beyond(y, tanY);
+}
+
+bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& camera) {
+  if (!patch.cullable) return false;
+  const std::array<Vec3, 16> p = set.bsplinePoints(patch);
+  // The derivatives are convex combinations of the point differences along s and along t, so
+  // the normal ds x dt lies in the cone of their cross products.
+  std::array<Vec3, 12> ds, dt;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      ds[r * 3 + c] = p[r * 4 + c + 1] - p[r * 4 + c];
+      dt[r * 3 + c] = p[(c + 1) * 4 + r] - p[c * 4 + r];
+    }
+  }
+  // Which way ds x dt turns relative to the surface normal, read at the centre.
+  Vec3 position, centreDs, centreDt;
+  set.evaluate(patch, 0.5, 0.5, position, centreDs, centreDt);
+  const Vec3 centreNormal = cross(centreDs, centreDt);
+  Vec3 sum{0, 0, 0};
+  for (const Vec3& a : ds) {
+    for (const Vec3& b : dt) sum += cross(a, b);
+  }
+  const double orientation = dot(sum, centreNormal) < 0 ? -1.0 : 1.0;
+
+  Vec3 centre{0, 0, 0};
+  for (const Vec3& q : p) centre += q / 16.0;
+  double radius = 0;
+  for (const Vec3& q : p) radius = std::max(radius, length(q - centre));
+  const bool perspective = camera.projection() == Projection::Perspective;
+  const Vec3 toCentre = perspective ? centre - camera.eye() : camera.forward();
+  const double reach = perspective ? radius : 0.0;
+  for (const Vec3& a : ds) {
+    for (const Vec3& b : dt) {
+      const Vec3 n = cross(a, b) * orientation;
+      const double len = length(n);
+      if (len == 0) continue;  // a zero difference adds nothing to the cone
+      // n . (q - eye) > 0 for every q within `reach` of the centre.
+      if (dot(n, toCentre) <= len * (reach + 1e-9 * length(toCentre))) return false;
+    }
+  }
+  return true;
+}
+
+PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
+                            const TessellationOptions& options, const CancelToken& cancel) {
+  return Tessellator(patches, camera, options, cancel).run();
+}
+
+}  // namespace limn::render::patches

@@ -1,0 +1,239 @@
+// Feature-adaptive patches (render/patches): the patch table against the limit surface, patch
+// counts that grow with the features rather than 4x per level, crack-free tessellation across
+// isolation levels, and back-patch culling that only drops hidden patches.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <tuple>
+
+#include "render/patches/patch_set.h"
+#include "render/patches/patch_tessellation.h"
+#include "render/subdiv/limit_surface.h"
+#include "tests/support/random_views.h"
+#include "tests/unit/test_meshes.h"
+
+namespace limn::render::patches {
+namespace {
+
+using mesh::ControlMesh;
+
+// A pentagonal prism, unsplit: its caps are Catmull-Clark n-gons (Ptex sub-faces).
+ControlMesh pentagonalPrism() {
+  ControlMesh m;
+  const int n = 5;
+  for (int k = 0; k < n; ++k) {
+    double a = 2 * std::numbers::pi * k / n;
+    m.points.push_back({std::cos(a), std::sin(a), -0.6});
+    m.points.push_back({std::cos(a), std::sin(a), 0.6});
+  }
+  for (int k = 0; k < n; ++k) {
+    int next = (k + 1) % n;
+    limn::testing::addFace(m, {2 * k, 2 * next, 2 * next + 1, 2 * k + 1});
+  }
+  m.faceVertexCounts.push_back(n);
+  for (int k = 0; k < n; ++k) m.faceVertexIndices.push_back(2 * (n - 1 - k));
+  m.faceVertexCounts.push_back(n);
+  for (int k = 0; k < n; ++k) m.faceVertexIndices.push_back(2 * k + 1);
+  return m;
+}
+
+std::vector<std::pair<std::string, ControlMesh>> closedMeshes() {
+  using namespace limn::testing;
+  return {{"cube", cube()},
+          {"sharp cube", sharpCube()},
+          {"semi-sharp cube", semiSharpCube()},
+          {"cube with sharp corners", cubeWithSharpCorners()},
+          {"creased torus", torus(12, 8, true)},
+          {"pentagonal prism", pentagonalPrism()},
+          {"loop icosahedron", icosahedron()},
+          {"sharp loop tetrahedron", sharpTetrahedron()}};
+}
+
+Camera viewOf(const PatchSet& set, int index, int side = 512) {
+  Bounds bounds = set.controlBounds();
+  auto views = limn::testing::randomViews(bounds, index + 1, 11, side);
+  return resolveCamera(views[index].camera, bounds);
+}
+
+TEST(PatchSet, AgreesWithTheLimitSurface) {
+  for (auto& [name, m] : closedMeshes()) {
+    subdiv::LimitSurface surface(m);
+    PatchSet set(m, subdiv::kApproxLevel, CancelToken());
+    const double diag = surface.bounds().diagonal();
+    double worst = 0;
+    for (const Patch& patch : set.patches()) {
+      for (Vec2 st : {Vec2{0.25, 0.25}, Vec2{0.5, 0.25}, Vec2{0.25, 0.5}}) {
+        Vec3 p, ds, dt;
+        set.evaluate(patch, st.x, st.y, p, ds, dt);
+        Vec2 uv = set.toFaceUV(patch, st.x, st.y);
+        subdiv::LimitSample exact = surface.evaluate(patch.baseFace, uv.x, uv.y);
+        worst = std::max(worst, length(p - exact.position) / diag);
+        EXPECT_GT(dot(normalize(cross(ds, dt)), exact.normal), 0.99) << name;
+      }
+    }
+    // Bfr builds the same patches at the same isolation level.
+    EXPECT_LT(worst, 1e-9) << name;
+  }
+}
+
+TEST(PatchSet, CountsGrowWithTheFeaturesNotFourfold) {
+  const ControlMesh m = limn::testing::cube();
+  std::vector<size_t> counts;
+  for (int isolation = 1; isolation <= 6; ++isolation) {
+    PatchSet set(m, isolation, CancelToken());
+    counts.push_back(set.stats().patches);
+    size_t irregular = 0;
+    for (const auto& level : set.stats().byLevel) irregular += level[3];
+    // Every cube corner is extraordinary: one Gregory end cap per face corner at the last level.
+    EXPECT_EQ(irregular, 24u) << isolation;
+  }
+  for (size_t k = 2; k < counts.size(); ++k) {
+    // Each level adds the same ring of patches around the 8 corners: linear growth.
+    EXPECT_EQ(counts[k] - counts[k - 1], counts[k - 1] - counts[k - 2]) << k;
+    EXPECT_LT(counts[k], 6u << (2 * (k + 1))) << k;  // uniform: 6 x 4^level faces
+  }
+}
+
+TEST(PatchSet, NewControlPointsMoveThePatches) {
+  ControlMesh m = limn::testing::cube();
+  PatchSet set(m, 3, CancelToken());
+  for (Vec3& p : m.points) p = p * 2.0;
+  set.setControlPoints(m.points);
+  subdiv::LimitSurface scaled(m);
+  const Patch& patch = set.patches().front();
+  Vec3 p, ds, dt;
+  set.evaluate(patch, 0.5, 0.5, p, ds, dt);
+  Vec2 uv = set.toFaceUV(patch, 0.5, 0.5);
+  EXPECT_LT(length(p - scaled.position(patch.baseFace, uv.x, uv.y)), 1e-3);
+  EXPECT_THROW(set.setControlPoints({}), std::invalid_argument);
+}
+
+// Every edge of the mesh is used by exactly two triangles, counted by vertex index and by
+// vertex position (no duplicate vertices either).
+void expectWatertight(const tessellate::TriangleMesh& mesh, const std::string& what) {
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  using Key = std::tuple<float, float, float>;
+  std::map<std::pair<Key, Key>, int> usesByPosition;
+  auto key = [&](uint32_t i) {
+    return Key{mesh.positions[i].x, mesh.positions[i].y, mesh.positions[i].z};
+  };
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      uint32_t a = mesh.indices[3 * t + k], b = mesh.indices[3 * t + (k + 1) % 3];
+      ++uses[std::minmax(a, b)];
+      ++usesByPosition[std::minmax(key(a), key(b))];
+    }
+  }
+  int bad = 0, badByPosition = 0;
+  for (const auto& [edge, count] : uses) bad += count != 2;
+  for (const auto& [edge, count] : usesByPosition) badByPosition += count != 2;
+  EXPECT_EQ(bad, 0) << what;
+  EXPECT_EQ(badByPosition, 0) << what;
+}
+
+TEST(PatchTessellation, IsWatertightAcrossLevelsAndDicingRates) {
+  for (auto& [name, m] : closedMeshes()) {
+    for (int isolation : {2, 4}) {
+      PatchSet set(m, isolation, CancelToken());
+      for (double rate : {1.5, 4.0, 40.0}) {
+        TessellationOptions options;
+        options.dicingRate = rate;
+        options.cullHidden = false;
+        Camera camera = viewOf(set, 1);
+        PatchMesh out = tessellatePatches(set, camera, options, CancelToken());
+        const std::string what = name + ", isolation " + std::to_string(isolation) + ", rate " +
+                                 std::to_string(rate);
+        expectWatertight(out.mesh, what);
+        EXPECT_EQ(out.stats.patchesDrawn, set.stats().patches) << what;
+        EXPECT_EQ(out.mesh.triangleFaces.size(), out.mesh.triangleCount());
+        EXPECT_EQ(out.trianglePatch.size(), out.mesh.triangleCount());
+        if (isolation == 4 && name != "sharp cube") {
+          EXPECT_GT(out.stats.transitionEdges, 0u) << what;
+        }
+      }
+    }
+  }
+}
+
+TEST(PatchTessellation, TrianglesFaceTheWayTheirNormalsDo) {
+  for (auto& [name, m] : closedMeshes()) {
+    PatchSet set(m, 3, CancelToken());
+    TessellationOptions options;
+    options.cullHidden = false;
+    PatchMesh out = tessellatePatches(set, viewOf(set, 0), options, CancelToken());
+    const auto& mesh = out.mesh;
+    size_t agree = 0, counted = 0;
+    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+      Vec3 p[3], n{0, 0, 0};
+      for (int k = 0; k < 3; ++k) {
+        p[k] = mesh.positions[mesh.indices[3 * t + k]].toDouble();
+        n += mesh.normals[mesh.indices[3 * t + k]].toDouble();
+      }
+      Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
+      if (length(face) < 1e-14) continue;
+      ++counted;
+      agree += dot(face, n) > 0;
+    }
+    EXPECT_GT(agree, counted * 999 / 1000) << name;
+  }
+}
+
+TEST(PatchTessellation, FinerDicingMakesMoreTrianglesAndTheBudgetIsHonoured) {
+  const ControlMesh m = limn::testing::torus(12, 8, true);
+  PatchSet set(m, 3, CancelToken());
+  Camera camera = viewOf(set, 0, 1024);
+  TessellationOptions coarse, fine;
+  coarse.dicingRate = 8;
+  fine.dicingRate = 1;
+  size_t few = tessellatePatches(set, camera, coarse, CancelToken()).mesh.triangleCount();
+  size_t many = tessellatePatches(set, camera, fine, CancelToken()).mesh.triangleCount();
+  EXPECT_GT(many, few * 8);
+  fine.maxTriangles = many / 2;
+  EXPECT_THROW(tessellatePatches(set, camera, fine, CancelToken()), InputError);
+}
+
+TEST(PatchCulling, DropsOnlyPatchesOutsideTheViewOrFacingAwayEverywhere) {
+  for (auto& [name, m] : closedMeshes()) {
+    PatchSet set(m, 3, CancelToken());
+    for (int view = 0; view < 4; ++view) {
+      Camera camera = viewOf(set, view);
+      size_t culled = 0;
+      for (const Patch& patch : set.patches()) {
+        if (outsideTheView(set, patch, camera)) {
+          for (int i = 0; i <= 4; ++i) {
+            for (int j = 0; j <= 4; ++j) {
+              Vec3 p, ds, dt;
+              set.evaluate(patch, i / 4.0, j / 4.0, p, ds, dt);
+              Vec3 pixel = camera.project(p);
+              bool inside = pixel.z > camera.nearPlane() && pixel.x >= 0 &&
+                            pixel.x <= camera.width() && pixel.y >= 0 &&
+                            pixel.y <= camera.height();
+              EXPECT_FALSE(inside) << name << " view " << view;
+            }
+          }
+          continue;
+        }
+        if (!facesAwayEverywhere(set, patch, camera)) continue;
+        ++culled;
+        for (int i = 0; i <= 4; ++i) {
+          for (int j = 0; j <= 4; ++j) {
+            Vec3 p, ds, dt;
+            set.evaluate(patch, i / 4.0, j / 4.0, p, ds, dt);
+            EXPECT_GT(dot(cross(ds, dt), camera.viewVector(p)), 0) << name << " view " << view;
+          }
+        }
+      }
+      TessellationOptions options;
+      PatchMesh out = tessellatePatches(set, camera, options, CancelToken());
+      EXPECT_EQ(out.stats.patchesCulled, culled) << name;
+      if (name == "cube" || name == "creased torus") {
+        EXPECT_GT(culled, 0u) << name << view;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace limn::render::patches
