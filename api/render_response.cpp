@@ -209,6 +209,8 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
   count("patchesDrawn", s.tessellation.patchesDrawn);
   count("patchesCulled", s.tessellation.patchesCulled);
   count("patchesOffScreen", s.tessellation.patchesOffScreen);
+  count("patchesSplit", s.tessellation.patchesSplit);
+  count("domains", s.tessellation.domains);
   count("transitionEdges", s.tessellation.transitionEdges);
   count("clampedEdges", s.tessellation.clampedEdges);
   numberField(w, "tableMs", s.tableMs);

@@ -61,8 +61,7 @@ std::vector<bool> facesOnTheBoundary(const Far::TopologyLevel& base) {
   return out;
 }
 
-PatchKind kindOf(Far::PatchDescriptor::Type type, const Far::PatchParam& param,
-                 bool onBoundary) {
+PatchKind kindOf(Far::PatchDescriptor::Type type, const Far::PatchParam& param, bool onBoundary) {
   if (type != Far::PatchDescriptor::REGULAR && type != Far::PatchDescriptor::LOOP) {
     return PatchKind::Irregular;
   }
@@ -100,8 +99,8 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
     Far::PtexIndices ptex(*refiner);
     for (int f = 0; f < base.GetNumFaces(); ++f) {
       const int first = ptex.GetFaceId(f);
-      const int count = (f + 1 < base.GetNumFaces() ? ptex.GetFaceId(f + 1) : ptex.GetNumFaces()) -
-                        first;
+      const int count =
+          (f + 1 < base.GetNumFaces() ? ptex.GetFaceId(f + 1) : ptex.GetNumFaces()) - first;
       for (int k = 0; k < count; ++k) ptexToFace.push_back({f, count > 1 ? k : -1});
     }
   }
@@ -162,8 +161,8 @@ void PatchSet::setControlPoints(const std::vector<Vec3>& points) {
     throw std::invalid_argument("a frame has " + std::to_string(points.size()) +
                                 " points; the mesh has " + std::to_string(controlPoints_));
   }
-  std::vector<subdiv::FarPoint> buffer(controlPoints_ + (stencils_ ? stencils_->GetNumStencils()
-                                                                   : 0));
+  std::vector<subdiv::FarPoint> buffer(controlPoints_ +
+                                       (stencils_ ? stencils_->GetNumStencils() : 0));
   for (size_t i = 0; i < controlPoints_; ++i) buffer[i].p = points[i];
   if (stencils_ && stencils_->GetNumStencils() > 0) {
     stencils_->UpdateValues(buffer.data(), buffer.data() + controlPoints_);
@@ -186,10 +185,10 @@ Vec2 PatchSet::toPtex(const Patch& patch, double s, double t) const {
 Vec2 PatchSet::toFaceUV(const Patch& patch, double s, double t) const {
   const Vec2 ptex = toPtex(patch, s, t);
   if (patch.subFace < 0) return ptex;
-  const OpenSubdiv::Bfr::Parameterization param(
-      scheme_ == mesh::Scheme::Loop ? OpenSubdiv::Sdc::SCHEME_LOOP
-                                    : OpenSubdiv::Sdc::SCHEME_CATMARK,
-      patch.faceSize);
+  const OpenSubdiv::Bfr::Parameterization param(scheme_ == mesh::Scheme::Loop
+                                                    ? OpenSubdiv::Sdc::SCHEME_LOOP
+                                                    : OpenSubdiv::Sdc::SCHEME_CATMARK,
+                                                patch.faceSize);
   double st[2] = {ptex.x, ptex.y}, uv[2];
   param.ConvertNormalizedSubFaceToCoord(patch.subFace, st, uv);
   return {uv[0], uv[1]};

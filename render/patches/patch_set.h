@@ -42,8 +42,8 @@ struct Patch {
   int faceSize = 4;  // corners of the base face
   int depth = 0;     // refinement level of the patch (0: a regular base face)
   PatchKind kind = PatchKind::Regular;
-  bool triangle = false;   // Loop: the unit triangle; Catmull-Clark: the unit square
-  bool cullable = false;   // a regular patch without boundary: its 4 x 4 points bound it
+  bool triangle = false;  // Loop: the unit triangle; Catmull-Clark: the unit square
+  bool cullable = false;  // a regular patch without boundary: its 4 x 4 points bound it
   // Its points are convex combinations of its control points (every patch but those with a
   // boundary edge, whose extrapolated phantom points give some points negative weights).
   bool inHull = false;
@@ -82,8 +82,7 @@ class PatchSet {
   const Bounds& controlBounds() const { return controlBounds_; }
 
   // Position and first derivatives at patch-local (s, t): [0,1]^2, or the unit triangle.
-  void evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds,
-                Vec3& dt) const;
+  void evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds, Vec3& dt) const;
   // The patch's local (s, t) in its Ptex face's coordinates (a sub-face's for n-gons).
   Vec2 toPtex(const Patch& patch, double s, double t) const;
   // The patch's local (s, t) as Bfr's (u, v) on its base face (subdiv::LimitSurface's).

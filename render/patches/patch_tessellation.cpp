@@ -19,8 +19,12 @@ constexpr int kPatchesBetweenChecks = 256;
 // Patch corners closer than this (times the bounding diagonal) are one vertex: the same limit
 // point evaluated on two patches differs by rounding only.
 constexpr double kWeldTolerance = 1e-7;
-// Far's neighbours differ by one level; deeper splits are only followed this far.
-constexpr int kMaxSplitDepth = 4;
+// Neighbouring domains differ by a few levels (Far's by one, the domains a large patch is cut
+// into by up to kMaxDomainSplits); splits of an edge are followed this deep.
+constexpr int kMaxSplitDepth = 8;
+// A patch whose edges want more than maxEdgeFactor segments is cut into 4^k domains (what
+// deeper isolation would make of it), k at most this.
+constexpr int kMaxDomainSplits = 5;
 
 // Points within `tolerance` of each other, found through a grid of cells of that size.
 class Welder {
@@ -67,25 +71,75 @@ Vec2 lerp(Vec2 a, Vec2 b, double t) { return {a.x + (b.x - a.x) * t, a.y + (b.y 
 constexpr std::array<Vec2, 4> kQuadCorners = {Vec2{0, 0}, Vec2{1, 0}, Vec2{1, 1}, Vec2{0, 1}};
 constexpr std::array<Vec2, 3> kTriangleCorners = {Vec2{0, 0}, Vec2{1, 0}, Vec2{0, 1}};
 
-int cornerCount(const Patch& patch) { return patch.triangle ? 3 : 4; }
-Vec2 corner(const Patch& patch, int k) {
-  return patch.triangle ? kTriangleCorners[k] : kQuadCorners[k];
+// A part of one patch tessellated as a unit: the patch's local coordinates are
+// origin + a * axisA + b * axisB for the domain's own (a, b) in the unit square or triangle.
+struct Domain {
+  int patch = 0;  // index into PatchSet::patches()
+  bool triangle = false;
+  Vec2 origin{0, 0}, axisA{1, 0}, axisB{0, 1};
+
+  Vec2 toPatch(Vec2 ab) const {
+    return {origin.x + ab.x * axisA.x + ab.y * axisB.x, origin.y + ab.x * axisA.y + ab.y * axisB.y};
+  }
+  // One of the four children of a split: quadrants, or for triangles the three corner
+  // triangles and the inverted middle one (same orientation).
+  Domain child(int k) const {
+    const Vec2 half{0.5, 0.5};
+    Domain c = *this;
+    c.axisA = {axisA.x * 0.5, axisA.y * 0.5};
+    c.axisB = {axisB.x * 0.5, axisB.y * 0.5};
+    static constexpr std::array<Vec2, 4> kQuadOffsets = {Vec2{0, 0}, Vec2{0.5, 0}, Vec2{0, 0.5},
+                                                         Vec2{0.5, 0.5}};
+    static constexpr std::array<Vec2, 3> kTriangleOffsets = {Vec2{0, 0}, Vec2{0.5, 0},
+                                                             Vec2{0, 0.5}};
+    if (triangle && k == 3) {  // corners (1/2, 1/2), (0, 1/2), (1/2, 0)
+      c.origin = toPatch(half);
+      c.axisA = {-c.axisA.x, -c.axisA.y};
+      c.axisB = {-c.axisB.x, -c.axisB.y};
+      return c;
+    }
+    c.origin = toPatch(triangle ? kTriangleOffsets[k] : kQuadOffsets[k]);
+    return c;
+  }
+};
+
+// Lines across a patch, as three points each: its edges and middle lines (for triangles, the
+// lines joining edge midpoints, counted twice as they are half as long).
+using Line = std::array<Vec2, 3>;
+constexpr std::array<Line, 6> kQuadLines = {Line{Vec2{0, 0}, Vec2{0.5, 0}, Vec2{1, 0}},
+                                            Line{Vec2{0, 0.5}, Vec2{0.5, 0.5}, Vec2{1, 0.5}},
+                                            Line{Vec2{0, 1}, Vec2{0.5, 1}, Vec2{1, 1}},
+                                            Line{Vec2{0, 0}, Vec2{0, 0.5}, Vec2{0, 1}},
+                                            Line{Vec2{0.5, 0}, Vec2{0.5, 0.5}, Vec2{0.5, 1}},
+                                            Line{Vec2{1, 0}, Vec2{1, 0.5}, Vec2{1, 1}}};
+constexpr std::array<Line, 6> kTriangleLines = {
+    Line{Vec2{0, 0}, Vec2{0.5, 0}, Vec2{1, 0}},
+    Line{Vec2{1, 0}, Vec2{0.5, 0.5}, Vec2{0, 1}},
+    Line{Vec2{0, 1}, Vec2{0, 0.5}, Vec2{0, 0}},
+    Line{Vec2{0.5, 0}, Vec2{0.25, 0.25}, Vec2{0, 0.5}},
+    Line{Vec2{0.5, 0}, Vec2{0.5, 0.25}, Vec2{0.5, 0.5}},
+    Line{Vec2{0, 0.5}, Vec2{0.25, 0.5}, Vec2{0.5, 0.5}}};
+
+int cornerCount(const Domain& domain) { return domain.triangle ? 3 : 4; }
+Vec2 corner(const Domain& domain, int k) {
+  return domain.triangle ? kTriangleCorners[k] : kQuadCorners[k];
 }
 
 struct Sample {
   Vec3 position, normal;
 };
 
-// The unit normal at (s, t); where the derivatives vanish (some end-cap corners), the normal a
-// little way towards the patch centre.
-Sample evaluateSample(const PatchSet& set, const Patch& patch, Vec2 st) {
+// Position and unit normal at the domain's (a, b); where the derivatives vanish (some end-cap
+// corners), the normal a little way towards the domain's centre.
+Sample evaluateSample(const PatchSet& set, const Domain& domain, Vec2 ab) {
+  const Patch& patch = set.patches()[domain.patch];
   Sample out;
   Vec3 ds, dt;
+  const Vec2 st = domain.toPatch(ab);
   set.evaluate(patch, st.x, st.y, out.position, ds, dt);
   Vec3 n = cross(ds, dt);
-  const Vec2 centre = patch.triangle ? Vec2{1.0 / 3, 1.0 / 3} : Vec2{0.5, 0.5};
-  for (double step = 1e-4; length(n) <= 1e-12 * length(ds) * length(dt) && step < 0.5;
-       step *= 10) {
+  const Vec2 centre = domain.toPatch(domain.triangle ? Vec2{1.0 / 3, 1.0 / 3} : Vec2{0.5, 0.5});
+  for (double step = 1e-4; length(n) <= 1e-12 * length(ds) * length(dt) && step < 0.5; step *= 10) {
     Vec3 ignored;
     const Vec2 in = lerp(st, centre, step);
     set.evaluate(patch, in.x, in.y, ignored, ds, dt);
@@ -96,7 +150,7 @@ Sample evaluateSample(const PatchSet& set, const Patch& patch, Vec2 st) {
   return out;
 }
 
-// One piece of a patch edge between two welded vertices, in the patch's local coordinates.
+// One piece of a domain edge between two welded vertices, in the domain's coordinates.
 struct Piece {
   int from, to;
   Vec2 a, b;
@@ -121,8 +175,8 @@ void zip(const std::vector<int>& outer, const std::vector<Vec2>& outerAt,
     out.cornerLocal.insert(out.cornerLocal.end(), {l0, l1, l2});
   };
   while (a < m || b < n) {
-    const bool advanceOuter =
-        b == n || (a < m && (a + 0.5) / static_cast<double>(m) <= (b + 0.5) / static_cast<double>(n));
+    const bool advanceOuter = b == n || (a < m && (a + 0.5) / static_cast<double>(m) <=
+                                                      (b + 0.5) / static_cast<double>(n));
     if (advanceOuter) {
       emit(outer[a], outerAt[a], outer[a + 1], outerAt[a + 1], inner[b], innerAt[b]);
       ++a;
@@ -153,7 +207,9 @@ void tessellateQuadInside(const Ring& ring, int maxFactor, PatchInside& out) {
   const int iu = std::clamp(std::max(seg[0], seg[2]), 2, maxFactor);
   const int iv = std::clamp(std::max(seg[1], seg[3]), 2, maxFactor);
   auto interiorId = [&](int i, int j) { return ~((j - 1) * (iu - 1) + (i - 1)); };
-  auto at = [&](int i, int j) { return Vec2{static_cast<double>(i) / iu, static_cast<double>(j) / iv}; };
+  auto at = [&](int i, int j) {
+    return Vec2{static_cast<double>(i) / iu, static_cast<double>(j) / iv};
+  };
   for (int j = 1; j < iv; ++j) {
     for (int i = 1; i < iu; ++i) out.interior.push_back(at(i, j));
   }
@@ -162,9 +218,8 @@ void tessellateQuadInside(const Ring& ring, int maxFactor, PatchInside& out) {
       const int a = interiorId(i, j), b = interiorId(i + 1, j), c = interiorId(i + 1, j + 1),
                 d = interiorId(i, j + 1);
       out.triangles.insert(out.triangles.end(), {a, b, c, a, c, d});
-      out.cornerLocal.insert(out.cornerLocal.end(),
-                             {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1),
-                              at(i, j + 1)});
+      out.cornerLocal.insert(out.cornerLocal.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1),
+                                                     at(i, j), at(i + 1, j + 1), at(i, j + 1)});
     }
   }
   // The inner ring's sides, in the same turning order as the outer ones.
@@ -200,7 +255,9 @@ void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out)
     count += n - 1 - j;
   }
   auto interiorId = [&](int i, int j) { return ~(rowStart[j] + (i - 1)); };
-  auto at = [&](int i, int j) { return Vec2{static_cast<double>(i) / n, static_cast<double>(j) / n}; };
+  auto at = [&](int i, int j) {
+    return Vec2{static_cast<double>(i) / n, static_cast<double>(j) / n};
+  };
   for (int j = 1; j <= n - 2; ++j) {
     for (int i = 1; i + j <= n - 1; ++i) out.interior.push_back(at(i, j));
   }
@@ -212,7 +269,8 @@ void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out)
       if (i + j <= n - 3) {
         out.triangles.insert(out.triangles.end(), {interiorId(i + 1, j), interiorId(i + 1, j + 1),
                                                    interiorId(i, j + 1)});
-        out.cornerLocal.insert(out.cornerLocal.end(), {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+        out.cornerLocal.insert(out.cornerLocal.end(),
+                               {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
       }
     }
   }
@@ -232,7 +290,7 @@ void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out)
 }
 
 // Triangles the inside of a patch will make (checked against the budget before evaluating).
-size_t insideTriangles(const Patch& patch, const Ring& ring, int maxFactor) {
+size_t insideTriangles(const Domain& patch, const Ring& ring, int maxFactor) {
   int most = 1, sum = 0;
   for (size_t k = 0; k < ring.ids.size(); ++k) {
     most = std::max(most, ring.segments(static_cast<int>(k)));
@@ -254,14 +312,14 @@ class Tessellator {
         welder_(positions_, kWeldTolerance * std::max(set.controlBounds().diagonal(), 1e-300)) {}
 
   PatchMesh run() {
-    const std::vector<Patch>& patches = set_.patches();
-    weldCorners();
     chooseCulled();
+    makeDomains();
+    const std::vector<Domain>& patches = domains_;
+    weldCorners();
     std::vector<Ring> rings(patches.size());
     size_t triangles = 0;
     for (size_t p = 0; p < patches.size(); ++p) {
       if (p % kPatchesBetweenChecks == 0) cancel_.check();
-      if (culled_[p]) continue;
       rings[p] = ringOf(p);
       triangles += insideTriangles(patches[p], rings[p], options_.maxEdgeFactor);
     }
@@ -275,7 +333,6 @@ class Tessellator {
     parallelFor(patches.size(), 64, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
         if (p % kPatchesBetweenChecks == 0) cancel_.check();
-        if (culled_[p]) continue;
         PatchInside& in = insides[p];
         if (patches[p].triangle) {
           tessellateTriangleInside(rings[p], options_.maxEdgeFactor, in);
@@ -283,7 +340,8 @@ class Tessellator {
           tessellateQuadInside(rings[p], options_.maxEdgeFactor, in);
         }
         in.samples.reserve(in.interior.size());
-        for (const Vec2& st : in.interior) in.samples.push_back(evaluateSample(set_, patches[p], st));
+        for (const Vec2& ab : in.interior)
+          in.samples.push_back(evaluateSample(set_, patches[p], ab));
       }
     });
     cancel_.check();
@@ -298,7 +356,7 @@ class Tessellator {
   }
 
   void weldCorners() {
-    const std::vector<Patch>& patches = set_.patches();
+    const std::vector<Domain>& patches = domains_;
     std::vector<std::array<Sample, 4>> samples(patches.size());
     parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
@@ -320,23 +378,65 @@ class Tessellator {
     }
   }
 
+  // Per Far patch: 0 drawn, 1 outside the view, 2 facing away.
   void chooseCulled() {
     const std::vector<Patch>& patches = set_.patches();
-    culled_.assign(patches.size(), 0);
+    patchCulled_.assign(patches.size(), 0);
     if (!options_.cullHidden) return;
     const bool backFacesHidden = set_.closed() && seenFromOutside();
-    // 1: outside the view, 2: facing away.
     parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
         if (outsideTheView(set_, patches[p], camera_)) {
-          culled_[p] = 1;
+          patchCulled_[p] = 1;
         } else if (backFacesHidden && facesAwayEverywhere(set_, patches[p], camera_)) {
-          culled_[p] = 2;
+          patchCulled_[p] = 2;
         }
       }
     });
-    stats_.patchesOffScreen = std::count(culled_.begin(), culled_.end(), uint8_t{1});
-    stats_.patchesCulled = std::count(culled_.begin(), culled_.end(), uint8_t{2});
+    stats_.patchesOffScreen = std::count(patchCulled_.begin(), patchCulled_.end(), uint8_t{1});
+    stats_.patchesCulled = std::count(patchCulled_.begin(), patchCulled_.end(), uint8_t{2});
+  }
+
+  // Each patch as one domain, or as 4^k when its edges want more than maxEdgeFactor segments.
+  // Judged on projected polylines across the patch (its edges and middle lines), with a margin for
+  // the parts that come out longer than half after a cut.
+  void makeDomains() {
+    const std::vector<Patch>& patches = set_.patches();
+    std::vector<int> splits(patches.size(), 0);
+    parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        if (patchCulled_[p]) continue;
+        const Domain whole{static_cast<int>(p), patches[p].triangle};
+        double longest = 0;
+        for (const auto& line : whole.triangle ? kTriangleLines : kQuadLines) {
+          std::array<Vec3, 3> pixel;
+          for (int k = 0; k < 3; ++k) {
+            pixel[k] = camera_.project(evaluateSample(set_, whole, line[k]).position);
+          }
+          longest =
+              std::max(longest, std::hypot(pixel[0].x - pixel[1].x, pixel[0].y - pixel[1].y) +
+                                    std::hypot(pixel[1].x - pixel[2].x, pixel[1].y - pixel[2].y));
+        }
+        double wanted = longest / options_.dicingRate;
+        while (wanted > 0.75 * options_.maxEdgeFactor && splits[p] < kMaxDomainSplits) {
+          wanted *= 0.5;
+          ++splits[p];
+        }
+      }
+    });
+    for (size_t p = 0; p < patches.size(); ++p) {
+      if (patchCulled_[p]) continue;
+      if (splits[p] > 0) ++stats_.patchesSplit;
+      std::vector<Domain> level{Domain{static_cast<int>(p), patches[p].triangle}};
+      for (int k = 0; k < splits[p]; ++k) {
+        std::vector<Domain> finer;
+        for (const Domain& d : level) {
+          for (int c = 0; c < 4; ++c) finer.push_back(d.child(c));
+        }
+        level = std::move(finer);
+      }
+      domains_.insert(domains_.end(), level.begin(), level.end());
+    }
   }
 
   // The eye outside the surface and nothing of it clipped by the near plane: then every ray
@@ -351,12 +451,13 @@ class Tessellator {
   }
 
   // The edge from corner k to the next, cut where finer neighbours' corners lie on it.
-  void splitEdge(const Patch& patch, int from, int to, Vec2 a, Vec2 b, int depth,
+  void splitEdge(const Domain& patch, int from, int to, Vec2 a, Vec2 b, int depth,
                  std::vector<Piece>& out) {
     if (depth < kMaxSplitDepth) {
       const Vec2 mid = lerp(a, b, 0.5);
       Vec3 position, ds, dt;
-      set_.evaluate(patch, mid.x, mid.y, position, ds, dt);
+      const Vec2 st = patch.toPatch(mid);
+      set_.evaluate(set_.patches()[patch.patch], st.x, st.y, position, ds, dt);
       const int m = welder_.find(position);
       if (m >= 0 && m != from && m != to) {
         splitEdge(patch, from, m, a, mid, depth + 1, out);
@@ -385,7 +486,7 @@ class Tessellator {
 
   // The vertices strictly inside a piece, from `from` towards `to`; made by the first patch
   // that needs them.
-  std::vector<int> pieceVertices(const Patch& patch, const Piece& piece) {
+  std::vector<int> pieceVertices(const Domain& patch, const Piece& piece) {
     const bool forward = piece.from < piece.to;
     const std::pair<int, int> key = std::minmax(piece.from, piece.to);
     auto it = edgeVertices_.find(key);
@@ -405,7 +506,7 @@ class Tessellator {
   }
 
   Ring ringOf(size_t p) {
-    const Patch& patch = set_.patches()[p];
+    const Domain& patch = domains_[p];
     const int n = cornerCount(patch);
     Ring ring;
     ring.ids.resize(n);
@@ -434,16 +535,18 @@ class Tessellator {
     const std::vector<Patch>& patches = set_.patches();
     PatchMesh out;
     tessellate::TriangleMesh& mesh = out.mesh;
-    for (size_t p = 0; p < patches.size(); ++p) {
-      if (culled_[p]) continue;
-      ++stats_.patchesDrawn;
-      PatchInside& in = insides[p];
+    stats_.patchesDrawn = std::count(patchCulled_.begin(), patchCulled_.end(), uint8_t{0});
+    stats_.domains = domains_.size();
+    for (size_t d = 0; d < domains_.size(); ++d) {
+      const int p = domains_[d].patch;
+      PatchInside& in = insides[d];
       const int first = static_cast<int>(positions_.size());
       for (const Sample& s : in.samples) addVertex(s);
       for (size_t c = 0; c < in.triangles.size(); ++c) {
         const int id = in.triangles[c];
         mesh.indices.push_back(static_cast<uint32_t>(id >= 0 ? id : first + ~id));
-        const Vec2 uv = set_.toFaceUV(patches[p], in.cornerLocal[c].x, in.cornerLocal[c].y);
+        const Vec2 st = domains_[d].toPatch(in.cornerLocal[c]);
+        const Vec2 uv = set_.toFaceUV(patches[p], st.x, st.y);
         mesh.cornerUVs.push_back(Vec2f{static_cast<float>(uv.x), static_cast<float>(uv.y)});
       }
       const size_t count = in.triangles.size() / 3;
@@ -467,8 +570,9 @@ class Tessellator {
   const CancelToken& cancel_;
   std::vector<Vec3> positions_, normals_;
   Welder welder_;
-  std::vector<std::array<int, 4>> corners_;
-  std::vector<uint8_t> culled_;
+  std::vector<uint8_t> patchCulled_;
+  std::vector<Domain> domains_;              // the drawn patches, whole or cut
+  std::vector<std::array<int, 4>> corners_;  // welded corner vertices per domain
   std::map<std::pair<int, int>, std::vector<int>> edgeVertices_;
   TessellationStats stats_;
 };
@@ -485,7 +589,8 @@ bool outsideTheView(const PatchSet& set, const Patch& patch, const Camera& camer
   // The sphere in camera space against the four side planes (and, in perspective, the eye
   // plane): outside one of them entirely is outside the view.
   const Vec3 d = centre - camera.eye();
-  const double x = dot(d, camera.right()), y = dot(d, camera.trueUp()), z = dot(d, camera.forward());
+  const double x = dot(d, camera.right()), y = dot(d, camera.trueUp()),
+               z = dot(d, camera.forward());
   const double aspect = static_cast<double>(camera.width()) / camera.height();
   if (camera.projection() == Projection::Orthographic) {
     const double halfH = camera.orthoHeight() * 0.5, halfW = halfH * aspect;

@@ -1,7 +1,8 @@
 // tessellatePatches(): a PatchSet drawn for a camera as one watertight triangle mesh.
 //
 // Each patch edge gets a tessellation factor from its projected size (about `dicingRate`
-// pixels per segment, at most maxEdgeFactor). Factors and vertices are shared by construction:
+// pixels per segment, at most maxEdgeFactor); a patch whose edges want more is cut into 4^k
+// domains first, as deeper isolation would cut it. Factors and vertices are shared by construction:
 // patch corners are welded first; an edge whose midpoint is the corner of a finer neighbour
 // (Far's transition edges, where isolation levels meet) is split there, and each piece is
 // tessellated once, keyed by its welded end points, so both sides use the same vertices. The
@@ -32,12 +33,14 @@ struct TessellationStats {
   size_t patchesDrawn = 0;
   size_t patchesCulled = 0;     // facing away
   size_t patchesOffScreen = 0;  // outside the view
-  size_t transitionEdges = 0;  // patch edges split where a finer neighbour meets them
-  size_t clampedEdges = 0;     // edge pieces that wanted more than maxEdgeFactor segments
+  size_t patchesSplit = 0;      // drawn as several domains (their edges wanted > maxEdgeFactor)
+  size_t domains = 0;           // the units tessellated: whole patches and parts of split ones
+  size_t transitionEdges = 0;   // domain edges split where a finer neighbour meets them
+  size_t clampedEdges = 0;      // edge pieces that wanted more than maxEdgeFactor segments
 };
 
 struct PatchMesh {
-  tessellate::TriangleMesh mesh;      // with triangleFaces and cornerUVs (Bfr's, per base face)
+  tessellate::TriangleMesh mesh;       // with triangleFaces and cornerUVs (Bfr's, per base face)
   std::vector<int32_t> trianglePatch;  // index into PatchSet::patches(), per triangle
   TessellationStats stats;
 };

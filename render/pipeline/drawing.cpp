@@ -98,7 +98,7 @@ void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
     out.warnings.push_back(std::to_string(tessellation.stats.clampedEdges) +
                            " patch edges wanted more than " +
                            std::to_string(options.maxEdgeFactor) +
-                           " segments; raise params.isolation for finer patches");
+                           " segments even after cutting their patches into domains");
   }
   if (choice.outputs.patches) out.patchImageMesh = patches::patchColoredMesh(tessellation, set);
   out.stats.patches = set.stats().patches;

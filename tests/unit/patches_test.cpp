@@ -143,8 +143,8 @@ TEST(PatchTessellation, IsWatertightAcrossLevelsAndDicingRates) {
         options.cullHidden = false;
         Camera camera = viewOf(set, 1);
         PatchMesh out = tessellatePatches(set, camera, options, CancelToken());
-        const std::string what = name + ", isolation " + std::to_string(isolation) + ", rate " +
-                                 std::to_string(rate);
+        const std::string what =
+            name + ", isolation " + std::to_string(isolation) + ", rate " + std::to_string(rate);
         expectWatertight(out.mesh, what);
         EXPECT_EQ(out.stats.patchesDrawn, set.stats().patches) << what;
         EXPECT_EQ(out.mesh.triangleFaces.size(), out.mesh.triangleCount());
@@ -154,6 +154,22 @@ TEST(PatchTessellation, IsWatertightAcrossLevelsAndDicingRates) {
         }
       }
     }
+  }
+}
+
+// Patches whose edges want more than 64 segments are cut into domains (as deeper isolation
+// would cut them); the cuts meet their neighbours without cracks and no edge is clamped.
+TEST(PatchTessellation, CutsLargePatchesIntoDomainsWithoutCracks) {
+  for (auto& [name, m] : closedMeshes()) {
+    PatchSet set(m, 1, CancelToken());
+    TessellationOptions options;
+    options.dicingRate = 1.2;
+    options.cullHidden = false;
+    PatchMesh out = tessellatePatches(set, viewOf(set, 0, 512), options, CancelToken());
+    expectWatertight(out.mesh, name);
+    EXPECT_GT(out.stats.patchesSplit, 0u) << name;
+    EXPECT_GT(out.stats.domains, set.stats().patches) << name;
+    EXPECT_EQ(out.stats.clampedEdges, 0u) << name;
   }
 }
 
@@ -208,8 +224,7 @@ TEST(PatchCulling, DropsOnlyPatchesOutsideTheViewOrFacingAwayEverywhere) {
               set.evaluate(patch, i / 4.0, j / 4.0, p, ds, dt);
               Vec3 pixel = camera.project(p);
               bool inside = pixel.z > camera.nearPlane() && pixel.x >= 0 &&
-                            pixel.x <= camera.width() && pixel.y >= 0 &&
-                            pixel.y <= camera.height();
+                            pixel.x <= camera.width() && pixel.y >= 0 && pixel.y <= camera.height();
               EXPECT_FALSE(inside) << name << " view " << view;
             }
           }
