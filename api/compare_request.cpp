@@ -235,7 +235,7 @@ std::string methodLabel(Method method, const render::pipeline::MethodParams& par
   if (method == Method::Uniform) {
     label += ":" + std::to_string(params.level);
     main = "level";
-  } else if (method == Method::Adaptive) {
+  } else if (method == Method::Adaptive || method == Method::Patches) {
     label += ":" + json::formatNumber(params.dicingRate);
     main = "dicingRate";
   }

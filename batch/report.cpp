@@ -64,11 +64,11 @@ double valueOr(const std::map<std::string, double>& values, const char* key, dou
 
 // Methods in the order people read them: the cheapest family first, then by triangles.
 int familyRank(const std::string& method) {
-  static const char* const kOrder[] = {"coarse", "uniform", "adaptive", "silhouette"};
-  for (int i = 0; i < 4; ++i) {
+  static const char* const kOrder[] = {"coarse", "uniform", "adaptive", "patches", "silhouette"};
+  for (int i = 0; i < 5; ++i) {
     if (method == kOrder[i]) return i;
   }
-  return 4;
+  return 5;
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "tests/integration/http_client.h"
+#include "tests/integration/json_answer.h"
 #include "tests/integration/openapi_check.h"
 #include "tests/integration/server_process.h"
 
@@ -46,12 +47,6 @@ std::string smallRender() { return renderBody("coarse", 64, R"(, "outputs": ["co
 std::string slowRender() {
   return renderBody("adaptive", 1024,
                     R"(, "params": {"dicingRate": 0.25}, "outputs": ["color", "depth", "normal"])");
-}
-
-rapidjson::Document parseJson(const std::string& text) {
-  rapidjson::Document doc;
-  doc.Parse(text.c_str(), text.size());
-  return doc;
 }
 
 // The error code of a JSON error answer, or a description of what the body was instead.

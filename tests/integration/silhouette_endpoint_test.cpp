@@ -15,6 +15,7 @@
 
 #include "render/subdiv/limit_surface.h"
 #include "tests/integration/http_client.h"
+#include "tests/integration/json_answer.h"
 #include "tests/integration/server_process.h"
 #include "tests/support/random_views.h"
 #include "tests/support/shapes.h"
@@ -85,12 +86,6 @@ std::string torusMesh(int ring = 24, int tube = 12) {
   return out.str();
 }
 
-rapidjson::Document parseJson(const std::string& text) {
-  rapidjson::Document doc;
-  doc.Parse(text.c_str(), text.size());
-  return doc;
-}
-
 size_t count(const std::string& text, const std::string& what) {
   size_t n = 0;
   for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -138,13 +133,6 @@ double distance(const std::vector<Point>& loop, double x, double y) {
     best = std::min(best, std::hypot(a.px + t * dx - x, a.py + t * dy - y));
   }
   return best;
-}
-
-std::string errorField(const HttpResponse& r) {
-  auto doc = parseJson(r.body);
-  if (doc.HasParseError() || !doc.IsObject() || !doc.HasMember("error")) return "<not JSON>";
-  const auto& detail = doc["error"]["detail"];
-  return detail.HasMember("field") ? detail["field"].GetString() : "<no field>";
 }
 
 class SilhouetteEndpointTest : public ::testing::Test {

@@ -724,13 +724,20 @@ TEST(RenderRequest, WrongTypesNameTheField) {
 TEST(RenderRequest, UnknownMethodAndOutputListTheValidNames) {
   ApiError method = parseError(cubeRequest(R"(, "method": "magic")"));
   expectError(method, 400, "invalid_request");
-  EXPECT_TRUE(contains(method.message, R"("coarse", "uniform", "adaptive", "limit", "silhouette")"))
+  EXPECT_TRUE(contains(method.message,
+                       R"("coarse", "uniform", "adaptive", "limit", "silhouette", "patches")"))
       << method.message;
   EXPECT_TRUE(contains(method.message, "\"magic\"")) << method.message;
 
-  ApiError later = parseError(cubeRequest(R"(, "method": "patches")"));
-  expectError(later, 400, "invalid_request");
-  EXPECT_TRUE(contains(later.message, "not implemented yet")) << later.message;
+  ApiError gpu =
+      parseError(cubeRequest(R"(, "method": "patches", "params": {"tessellator": "gpu"})"));
+  expectError(gpu, 400, "invalid_request");
+  EXPECT_EQ(detailMember(gpu, "field"), "params.tessellator");
+  EXPECT_TRUE(contains(gpu.message, "not implemented yet")) << gpu.message;
+  ApiError patchImage =
+      parseError(cubeRequest(R"(, "method": "adaptive", "outputs": ["patches"])"));
+  expectError(patchImage, 400, "invalid_request");
+  EXPECT_TRUE(contains(patchImage.message, "method \"patches\" only")) << patchImage.message;
 
   ApiError output = parseError(cubeRequest(R"(, "outputs": ["color", "albedo"])"));
   expectError(output, 400, "invalid_request");
@@ -758,6 +765,8 @@ TEST(RenderRequest, OutOfRangeCameraAndParams) {
       {R"(, "camera": {"eye": [1, 2, 3], "target": [1, 2, 3]})", 400, "camera.eye", ""},
       {R"(, "params": {"level": -1})", 400, "params.level", ""},
       {R"(, "params": {"level": 7})", 413, "params.level", "maxLevel"},
+      {R"(, "params": {"isolation": 0})", 400, "params.isolation", ""},
+      {R"(, "params": {"isolation": 9})", 413, "params.isolation", "maxIsolation"},
       {R"(, "params": {"dicingRate": 0})", 400, "params.dicingRate", ""},
       {R"(, "params": {"dicingRate": 0.1})", 413, "params.dicingRate", "minDicingRate"},
       {R"(, "params": {"metricSupersample": 0})", 400, "params.metricSupersample", ""},

@@ -1,0 +1,201 @@
+// method "patches" through the real `limn serve` process: every project mesh from a random view
+// within a pixel of the exact outline; no crack where the reference is covered, at fine and
+// coarse dicing; the patch image of a cube shows rings of levels around its corners; culling
+// leaves the picture as it was; bad parameters are 4xx naming the field.
+#include <gtest/gtest.h>
+#include <rapidjson/document.h>
+
+#include <array>
+#include <cmath>
+#include <csignal>
+#include <string>
+#include <vector>
+
+#include "render/image/encode.h"
+#include "render/subdiv/limit_surface.h"
+#include "tests/integration/http_client.h"
+#include "tests/integration/json_answer.h"
+#include "tests/integration/server_process.h"
+#include "tests/support/random_views.h"
+#include "tests/support/shapes.h"
+
+namespace limn::testing {
+namespace {
+
+class PatchesEndpointTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    server_ = new ServerProcess(ServerProcess::withConfig(R"({"workers": 2, "queueDepth": 16})"));
+  }
+  static void TearDownTestSuite() {
+    EXPECT_EQ(server_->terminate(SIGTERM), 0);
+    delete server_;
+    server_ = nullptr;
+  }
+  static int port() { return server_->port(); }
+  static ServerProcess* server_;
+};
+ServerProcess* PatchesEndpointTest::server_ = nullptr;
+
+std::string patchesRequest(const NamedMesh& shape, int side, const std::string& params,
+                           const std::string& outputs, uint64_t seed = 5) {
+  render::subdiv::LimitSurface surface(shape.mesh);
+  RandomView view = randomViews(surface.bounds(), 1, viewSeed(seed, shape.name), side)[0];
+  return R"({"mesh": )" + requestMeshJson(shape.mesh) + R"(, "camera": )" +
+         describeCamera(view.camera) + R"(, "method": "patches", "params": )" + params +
+         R"(, "reference": true, "outputs": )" + outputs + "}";
+}
+
+render::Image image(const rapidjson::Value& images, const char* pass) {
+  return render::image::decode(decodeBase64(images[pass]["data"].GetString()));
+}
+
+TEST_F(PatchesEndpointTest, EveryProjectMeshFromARandomViewIsWithinAPixel) {
+  for (const NamedMesh& shape : ownShapes()) {
+    HttpResponse r = post(port(), "/v1/render", patchesRequest(shape, 384, R"({"dicingRate": 1})", "[]"));
+    ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
+    auto doc = parseJson(r.body);
+    EXPECT_LE(doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 1.0) << shape.name;
+    const auto& table = doc["stats"]["patchTable"];
+    EXPECT_GT(table["patches"].GetUint64(), 0u) << shape.name;
+    EXPECT_EQ(doc["stats"]["patches"].GetUint64(), table["patches"].GetUint64());
+    EXPECT_EQ(table["clampedEdges"].GetUint64(), 0u) << shape.name;
+  }
+}
+
+// A crack shows as a pixel the reference covers and the patches miss, inside the surface
+// (away from its outline, where a pixel can go either way).
+TEST_F(PatchesEndpointTest, NoCrackWhereTheReferenceIsCovered) {
+  for (const NamedMesh& shape :
+       selectShapes(ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_cube_sharp_corners",
+                                  "own_icosahedron_loop", "own_pawn_588"})) {
+    for (const char* params : {R"({"dicingRate": 1, "isolation": 2})",
+                               R"({"dicingRate": 12, "isolation": 5})"}) {
+      HttpResponse r = post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["mask"])"));
+      ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
+      auto doc = parseJson(r.body);
+      render::Image mask = image(doc["images"], "mask");
+      render::Image exact = image(doc["reference"]["images"], "mask");
+      auto covered = [](const render::Image& m, int x, int y) { return m.at(x, y, 0) > 0.5f; };
+      int holes = 0, inside = 0;
+      for (int y = 2; y + 2 < exact.height; ++y) {
+        for (int x = 2; x + 2 < exact.width; ++x) {
+          bool interior = true;
+          for (int dy = -2; dy <= 2; ++dy) {
+            for (int dx = -2; dx <= 2; ++dx) interior = interior && covered(exact, x + dx, y + dy);
+          }
+          if (!interior) continue;
+          ++inside;
+          holes += !covered(mask, x, y);
+        }
+      }
+      EXPECT_GT(inside, 1000) << shape.name;
+      EXPECT_EQ(holes, 0) << shape.name << " " << params;
+    }
+  }
+}
+
+// Level colours of the patch image (docs/api.md): hue by level; compared by chromaticity, as
+// shading scales the brightness.
+TEST_F(PatchesEndpointTest, CubePatchImageShowsRingsOfLevelsAroundTheCorners) {
+  const std::string body =
+      R"({"mesh": )" + requestMeshJson(selectShapes(ownShapes(), {"own_cube"})[0].mesh) +
+      R"(, "camera": {"eye": [2.2, 1.7, 2.9], "width": 384, "height": 384}, "method": "patches",
+          "params": {"isolation": 4, "dicingRate": 2}, "outputs": ["patches"]})";
+  HttpResponse r = post(port(), "/v1/render", body);
+  ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+  auto doc = parseJson(r.body);
+  render::Image picture = image(doc["images"], "patches");
+  const std::array<std::array<float, 3>, 3> levels = {
+      std::array<float, 3>{0.25f, 0.70f, 0.30f}, {0.65f, 0.80f, 0.20f}, {0.95f, 0.80f, 0.15f}};
+  std::array<int, 4> count{};  // levels 2, 3, 4 and grey end caps
+  int coveredPixels = 0;
+  for (int y = 0; y < picture.height; ++y) {
+    for (int x = 0; x < picture.width; ++x) {
+      if (picture.at(x, y, 3) < 0.5f) continue;
+      ++coveredPixels;
+      float r = picture.at(x, y, 0), g = picture.at(x, y, 1), b = picture.at(x, y, 2);
+      if (std::max({r, g, b}) - std::min({r, g, b}) < 0.04f) {
+        ++count[3];
+        continue;
+      }
+      int best = -1;
+      double bestDistance = 0.02;  // chromaticity distance at most
+      for (int k = 0; k < 3; ++k) {
+        const auto& c = levels[k];
+        double sum = r + g + b, csum = c[0] + c[1] + c[2];
+        double d = std::hypot(r / sum - c[0] / csum, g / sum - c[1] / csum);
+        if (d < bestDistance) bestDistance = d, best = k;
+      }
+      if (best >= 0) ++count[best];
+    }
+  }
+  ASSERT_GT(coveredPixels, 8000);
+  // Rings shrink towards the corners: each level covers less than the one before, and the
+  // end caps at the corners least.
+  EXPECT_GT(count[0], count[1]);
+  EXPECT_GT(count[1], count[2]);
+  EXPECT_GT(count[2], count[3]);
+  EXPECT_GT(count[3], 20);
+}
+
+TEST_F(PatchesEndpointTest, CullingLeavesTheImageAsItWas) {
+  for (const NamedMesh& shape :
+       selectShapes(ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_bumpy_ball_1536"})) {
+    std::array<render::Image, 2> pictures;
+    std::array<size_t, 2> triangles{};
+    for (int cull = 0; cull < 2; ++cull) {
+      std::string params = std::string(R"({"dicingRate": 2, "cullPatches": )") +
+                           (cull ? "true" : "false") + "}";
+      HttpResponse r = post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["color"])"));
+      ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
+      auto doc = parseJson(r.body);
+      pictures[cull] = image(doc["images"], "color");
+      triangles[cull] = doc["stats"]["triangles"].GetUint64();
+      if (cull) {
+        EXPECT_GT(doc["stats"]["patchTable"]["patchesCulled"].GetUint64(), 0u) << shape.name;
+      }
+    }
+    EXPECT_LT(triangles[1], triangles[0]) << shape.name;
+    int differing = 0, covered = 0;
+    for (int y = 0; y < pictures[0].height; ++y) {
+      for (int x = 0; x < pictures[0].width; ++x) {
+        covered += pictures[0].at(x, y, 3) > 0.5f;
+        float most = 0;
+        for (int c = 0; c < 4; ++c) {
+          most = std::max(most, std::fabs(pictures[0].at(x, y, c) - pictures[1].at(x, y, c)));
+        }
+        differing += most > 2.5f / 255;
+      }
+    }
+    EXPECT_LE(differing, covered / 1000) << shape.name;
+  }
+}
+
+TEST_F(PatchesEndpointTest, BadParametersNameTheFieldAndTheServerCarriesOn) {
+  const NamedMesh cube = selectShapes(ownShapes(), {"own_cube"})[0];
+  struct Case {
+    std::string params, outputs;
+    int status;
+    const char* field;
+  };
+  const std::vector<Case> cases = {
+      {R"({"isolation": 9})", "[]", 413, "params.isolation"},
+      {R"({"isolation": 0})", "[]", 400, "params.isolation"},
+      {R"({"isolation": "deep"})", "[]", 400, "params.isolation"},
+      {R"({"tessellator": "gpu"})", "[]", 400, "params.tessellator"},
+      {R"({"tessellator": "magic"})", "[]", 400, "params.tessellator"},
+      {R"({"cullPatches": 1})", "[]", 400, "params.cullPatches"},
+      {R"({"dicingRate": 0.01})", "[]", 413, "params.dicingRate"},
+  };
+  for (const Case& c : cases) {
+    HttpResponse r = post(port(), "/v1/render", patchesRequest(cube, 64, c.params, c.outputs));
+    EXPECT_EQ(r.status, c.status) << c.params << ": " << r.body.substr(0, 300);
+    EXPECT_EQ(errorField(r), c.field) << r.body.substr(0, 300);
+  }
+  HttpResponse ok = post(port(), "/v1/render", patchesRequest(cube, 64, "{}", R"(["color"])"));
+  EXPECT_EQ(ok.status, 200);
+}
+
+}  // namespace
+}  // namespace limn::testing
