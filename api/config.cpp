@@ -118,6 +118,8 @@ void readLimits(const Value& object, const std::string& source, ServiceConfig& c
   r.size("maxSupersampledPixels", limits.maxSupersampledPixels, 1);
   r.integer("maxLevel", limits.maxLevel, 0);
   r.integer("maxIsolation", limits.maxIsolation, 1);
+  r.size("maxFrames", limits.maxFrames, 1);
+  r.size("maxFramePixels", limits.maxFramePixels, 1);
   r.number("minDicingRate", limits.minDicingRate, 0.0);
   r.integer("maxSearchSteps", limits.maxSearchSteps, 0);
   r.integer("maxCurveSamples", limits.maxCurveSamples, 0);

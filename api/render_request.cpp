@@ -188,6 +188,36 @@ render::pipeline::Outputs readOutputs(const Value& value) {
   return out;
 }
 
+// "frames": [[[x, y, z], ...], ...]: the control points of each animation frame.
+std::vector<std::vector<render::Vec3>> readFrames(const Value& value,
+                                                  const render::pipeline::RenderJob& job,
+                                                  const JobLimits& limits) {
+  json::requireArray(value, "frames");
+  if (job.method != Method::Patches) {
+    json::fail("frames", "frames are drawn by method \"patches\" only");
+  }
+  if (value.Size() == 0) json::fail("frames", "frames must hold at least one frame");
+  if (value.Size() > limits.maxFrames) {
+    throw tooLarge("maxFrames", "frames",
+                   "frames: " + std::to_string(value.Size()) + " exceed limit maxFrames (" +
+                       std::to_string(limits.maxFrames) + ")");
+  }
+  std::vector<std::vector<render::Vec3>> frames(value.Size());
+  for (rapidjson::SizeType f = 0; f < value.Size(); ++f) {
+    const std::string field = "frames[" + std::to_string(f) + "]";
+    json::requireArray(value[f], field);
+    if (value[f].Size() != job.mesh.points.size()) {
+      json::fail(field, field + " has " + std::to_string(value[f].Size()) +
+                            " points; the mesh has " + std::to_string(job.mesh.points.size()));
+    }
+    frames[f].reserve(value[f].Size());
+    for (rapidjson::SizeType i = 0; i < value[f].Size(); ++i) {
+      frames[f].push_back(json::vec3(value[f][i], field + "[" + std::to_string(i) + "]"));
+    }
+  }
+  return frames;
+}
+
 // {"id": "..."}: a mesh uploaded before with POST /v1/meshes.
 render::mesh::ControlMesh storedMesh(const Value& mesh, render::mesh::MeshCache* meshes) {
   for (auto it = mesh.MemberBegin(); it != mesh.MemberEnd(); ++it) {
@@ -255,10 +285,10 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   RenderRequest request;
   std::vector<std::string>& warnings = request.warnings;
   render::pipeline::RenderJob& job = request.job;
-  warnUnknownFields(
-      root, "",
-      {"mesh", "camera", "method", "params", "shading", "outputs", "reference", "imageFormat"},
-      warnings);
+  warnUnknownFields(root, "",
+                    {"mesh", "camera", "method", "params", "shading", "outputs", "reference",
+                     "imageFormat", "frames"},
+                    warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
   }
@@ -297,6 +327,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   const Value* mesh = json::find(root, "mesh");
   if (!mesh) json::fail("mesh", "mesh is required");
   job.mesh = parseMesh(*mesh, limits, warnings, meshes);
+  if (const Value* v = json::find(root, "frames")) job.frames = readFrames(*v, job, limits);
 
   request::checkCameraAgainstMesh(job.camera, job.mesh);
   return request;

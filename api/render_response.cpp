@@ -218,6 +218,23 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
   w.EndObject();
 }
 
+void writeFrames(Writer& w, const std::vector<render::pipeline::RenderResult::Frame>& frames,
+                 const AnswerShape& shape, std::vector<std::string>& warnings) {
+  w.Key("frames");
+  w.StartArray();
+  for (const auto& frame : frames) {
+    w.StartObject();
+    w.Key("images");
+    writeImages(w, frame.images, shape, "method", warnings);
+    w.Key("triangles");
+    w.Uint64(frame.triangles);
+    numberField(w, "approxMs", frame.approxMs);
+    numberField(w, "rasterMs", frame.rasterMs);
+    w.EndObject();
+  }
+  w.EndArray();
+}
+
 void writeStats(Writer& w, const render::pipeline::Stats& s) {
   w.StartObject();
   w.Key("controlVertices");
@@ -351,7 +368,13 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
   Writer w(buffer);
   w.StartObject();
   w.Key("images");
-  writeImages(w, result.images, shape, "method", warnings);
+  if (result.frames.empty()) {
+    writeImages(w, result.images, shape, "method", warnings);
+  } else {  // each frame has its own
+    w.StartObject();
+    w.EndObject();
+    writeFrames(w, result.frames, shape, warnings);
+  }
   if (shape.reference) {
     w.Key("reference");
     w.StartObject();

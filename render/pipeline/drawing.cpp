@@ -81,12 +81,13 @@ tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobL
                          " is not tessellated here");
 }
 
-// The patches method: Far's feature-adaptive patch table, tessellated for the camera.
-void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
-                            const Camera& camera, const CancelToken& cancel, Approximated& out) {
+}  // namespace
+
+void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
+                        const JobLimits& limits, const Camera& camera, const CancelToken& cancel,
+                        Approximated& out) {
   Stopwatch clock;
-  const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel);
-  Stats::Patches stats{.table = set.stats(), .tessellation = {}, .tableMs = clock.lapMs()};
+  Stats::Patches stats{.table = set.stats(), .tessellation = {}, .tableMs = set.stats().buildMs};
   patches::TessellationOptions options;
   options.dicingRate = choice.params.dicingRate;
   options.cullHidden = choice.params.cullPatches;
@@ -104,6 +105,15 @@ void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
   out.stats.patches = set.stats().patches;
   out.stats.patchTable = stats;
   out.mesh = std::move(tessellation.mesh);
+}
+
+namespace {
+
+// The patches method: Far's feature-adaptive patch table, tessellated for the camera.
+void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
+                            const Camera& camera, const CancelToken& cancel, Approximated& out) {
+  const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel);
+  tessellatePatchSet(set, choice, limits, camera, cancel, out);
 }
 
 }  // namespace
@@ -144,9 +154,15 @@ MethodDrawing drawMethod(const MethodChoice& choice, const JobLimits& limits,
                          const subdiv::LimitSurface& surface, const Camera& camera,
                          RenderContext& context, bool measured, int supersample,
                          const CancelToken& cancel) {
-  MethodDrawing drawing{.approx = approximateMethod(choice, limits, surface, camera, cancel),
-                        .images = {},
-                        .rasterMs = 0};
+  return rasterizeApproximation(approximateMethod(choice, limits, surface, camera, cancel), choice,
+                                surface, camera, context, measured, supersample, cancel);
+}
+
+MethodDrawing rasterizeApproximation(Approximated approx, const MethodChoice& choice,
+                                     const subdiv::LimitSurface& surface, const Camera& camera,
+                                     RenderContext& context, bool measured, int supersample,
+                                     const CancelToken& cancel) {
+  MethodDrawing drawing{.approx = std::move(approx), .images = {}, .rasterMs = 0};
   Stopwatch clock;
   if (choice.method == Method::Silhouette && choice.shading == Shading::NormalMap) {
     mapNormals(drawing.approx.mesh, makeAtlas(drawing.approx.drawnOn(surface), camera));

@@ -58,6 +58,12 @@ Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limi
                                const subdiv::LimitSurface& surface, const Camera& camera,
                                const CancelToken& cancel);
 
+// The patches method on a patch table already built (animation frames reuse one): its
+// tessellation for `camera`, stats and, with outputs.patches, the patch image's mesh.
+void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
+                        const JobLimits& limits, const Camera& camera, const CancelToken& cancel,
+                        Approximated& out);
+
 // An approximation and its raster passes.
 struct MethodDrawing {
   Approximated approx;
@@ -71,6 +77,12 @@ MethodDrawing drawMethod(const MethodChoice& choice, const JobLimits& limits,
                          const subdiv::LimitSurface& surface, const Camera& camera,
                          RenderContext& context, bool measured, int supersample,
                          const CancelToken& cancel);
+
+// The raster passes of an approximation made already (drawMethod's second half).
+MethodDrawing rasterizeApproximation(Approximated approx, const MethodChoice& choice,
+                                     const subdiv::LimitSurface& surface, const Camera& camera,
+                                     RenderContext& context, bool measured, int supersample,
+                                     const CancelToken& cancel);
 
 // The passes a reference must cast for a camera: all of them, and the supersampled mask when
 // something is measured against it.

@@ -82,6 +82,10 @@ struct JobLimits {
   // Rows of one comparison (methods x cameras): each camera holds every method's images at
   // once (about 100 MB per method at 1024^2, S = 4) until its reference is built.
   size_t maxCompareRows = 64;
+  // Animation frames of one request, and their image pixels (frames x width x height x
+  // requested outputs): each frame holds its images until the answer is written.
+  size_t maxFrames = 120;
+  size_t maxFramePixels = size_t{1} << 24;
 };
 
 struct RenderJob {
@@ -92,6 +96,9 @@ struct RenderJob {
   Shading shading = Shading::Smooth;
   Outputs outputs;
   bool reference = false;
+  // Method patches: the control points of each animation frame (same topology as `mesh`);
+  // empty: one image of mesh.points. The patch table is built once and re-evaluated per frame.
+  std::vector<std::vector<Vec3>> frames;
 };
 
 struct Stats {
@@ -142,6 +149,13 @@ struct RenderResult {
   Timings timings;
   std::vector<std::string> warnings;
   Camera camera;  // as resolved
+  // One per RenderJob::frames entry (then `images` is empty and stats are the first frame's).
+  struct Frame {
+    ImageSet images;
+    size_t triangles = 0;
+    double approxMs = 0, rasterMs = 0;
+  };
+  std::vector<Frame> frames;
 };
 
 // Per-thread resources a job runs with (each worker owns one).
@@ -155,6 +169,12 @@ struct RenderContext {
 // expires. The engine checks `limits` itself rather than trusting its caller.
 RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& context,
                  const CancelToken& cancel);
+
+// run() for a job with frames: one image set per frame, the patch table built once. Throws
+// InputError for frames with another method, with the reference, over maxFrames, or of the
+// wrong size.
+RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderContext& context,
+                       const CancelToken& cancel);
 
 const char* methodName(Method method);
 

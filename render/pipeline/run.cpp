@@ -120,6 +120,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   checkJob(job, limits);
   mesh::validateMesh(job.mesh, limits.mesh);
   cancel.check();
+  if (!job.frames.empty()) return runFrames(job, limits, context, cancel);
 
   const subdiv::LimitSurface surface(job.mesh, cancel);
   Camera camera = resolveCamera(job.camera, surface.bounds());
@@ -129,7 +130,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
                       .stats = {},
                       .timings = {},
                       .warnings = {},
-                      .camera = camera};
+                      .camera = camera,
+                      .frames = {}};
   result.timings.surfaceMs = clock.lapMs();
   result.stats.controlVertices = job.mesh.vertexCount();
   result.stats.controlFaces = job.mesh.faceCount();

@@ -111,7 +111,8 @@ RenderResult runImplicit(const ImplicitJob& job, const JobLimits& limits, Render
                       .stats = {},
                       .timings = {},
                       .warnings = {},
-                      .camera = camera};
+                      .camera = camera,
+                      .frames = {}};
   result.timings.surfaceMs = surfaceMs;
   result.stats.implicit = implicitStats(job, p);
   const tessellate::TriangleMesh& approx = p.mesh;

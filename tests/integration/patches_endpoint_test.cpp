@@ -8,6 +8,8 @@
 #include <array>
 #include <cmath>
 #include <csignal>
+#include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -52,7 +54,8 @@ render::Image image(const rapidjson::Value& images, const char* pass) {
 
 TEST_F(PatchesEndpointTest, EveryProjectMeshFromARandomViewIsWithinAPixel) {
   for (const NamedMesh& shape : ownShapes()) {
-    HttpResponse r = post(port(), "/v1/render", patchesRequest(shape, 384, R"({"dicingRate": 1})", "[]"));
+    HttpResponse r =
+        post(port(), "/v1/render", patchesRequest(shape, 384, R"({"dicingRate": 1})", "[]"));
     ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
     auto doc = parseJson(r.body);
     EXPECT_LE(doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 1.0) << shape.name;
@@ -69,9 +72,10 @@ TEST_F(PatchesEndpointTest, NoCrackWhereTheReferenceIsCovered) {
   for (const NamedMesh& shape :
        selectShapes(ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_cube_sharp_corners",
                                   "own_icosahedron_loop", "own_pawn_588"})) {
-    for (const char* params : {R"({"dicingRate": 1, "isolation": 2})",
-                               R"({"dicingRate": 12, "isolation": 5})"}) {
-      HttpResponse r = post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["mask"])"));
+    for (const char* params :
+         {R"({"dicingRate": 1, "isolation": 2})", R"({"dicingRate": 12, "isolation": 5})"}) {
+      HttpResponse r =
+          post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["mask"])"));
       ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
       auto doc = parseJson(r.body);
       render::Image mask = image(doc["images"], "mask");
@@ -145,9 +149,10 @@ TEST_F(PatchesEndpointTest, CullingLeavesTheImageAsItWas) {
     std::array<render::Image, 2> pictures;
     std::array<size_t, 2> triangles{};
     for (int cull = 0; cull < 2; ++cull) {
-      std::string params = std::string(R"({"dicingRate": 2, "cullPatches": )") +
-                           (cull ? "true" : "false") + "}";
-      HttpResponse r = post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["color"])"));
+      std::string params =
+          std::string(R"({"dicingRate": 2, "cullPatches": )") + (cull ? "true" : "false") + "}";
+      HttpResponse r =
+          post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["color"])"));
       ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
       auto doc = parseJson(r.body);
       pictures[cull] = image(doc["images"], "color");
@@ -169,6 +174,91 @@ TEST_F(PatchesEndpointTest, CullingLeavesTheImageAsItWas) {
       }
     }
     EXPECT_LE(differing, covered / 1000) << shape.name;
+  }
+}
+
+// A torus breathing (its points scaled about the centre by up to 30%) over `frames` frames, as
+// the request's "frames" array.
+std::string breathingFrames(const render::mesh::ControlMesh& rest, int frames) {
+  std::ostringstream out;
+  out << "[";
+  for (int f = 0; f < frames; ++f) {
+    const double scale = 1 + 0.3 * std::sin(2 * std::numbers::pi * f / frames);
+    out << (f ? "," : "") << "[";
+    for (size_t i = 0; i < rest.points.size(); ++i) {
+      const render::Vec3& p = rest.points[i];
+      out << (i ? "," : "") << "[" << p.x * scale << "," << p.y * scale << "," << p.z * scale
+          << "]";
+    }
+    out << "]";
+  }
+  out << "]";
+  return out.str();
+}
+
+TEST_F(PatchesEndpointTest, ThirtyFramesOfABreathingTorusFromOneTable) {
+  const NamedMesh torus = selectShapes(ownShapes(), {"own_torus_12x8_creased"})[0];
+  const std::string body = R"({"mesh": )" + requestMeshJson(torus.mesh) +
+                           R"(, "camera": {"eye": [0.5, -4, 3], "width": 128, "height": 128},
+      "method": "patches", "params": {"dicingRate": 4}, "outputs": ["mask"], "frames": )" +
+                           breathingFrames(torus.mesh, 30) + "}";
+  HttpResponse r = post(port(), "/v1/render", body);
+  ASSERT_EQ(r.status, 200) << r.body.substr(0, 400);
+  auto doc = parseJson(r.body);
+  ASSERT_TRUE(doc["frames"].IsArray());
+  ASSERT_EQ(doc["frames"].Size(), 30u);
+  EXPECT_EQ(doc["images"].MemberCount(), 0u);
+  EXPECT_EQ(doc["warnings"].Size(), 0u) << r.body.substr(0, 400);
+  std::vector<int> covered;
+  for (const auto& frame : doc["frames"].GetArray()) {
+    EXPECT_GT(frame["triangles"].GetUint64(), 0u);
+    render::Image mask = image(frame["images"], "mask");
+    int count = 0;
+    for (int y = 0; y < mask.height; ++y) {
+      for (int x = 0; x < mask.width; ++x) count += mask.at(x, y, 0) > 0.5f;
+    }
+    covered.push_back(count);
+  }
+  // The torus grows to frame 7 (scale 1.3) and shrinks to frame 22 (0.7): its area follows.
+  EXPECT_GT(covered[7], covered[0] * 1.3);
+  EXPECT_LT(covered[22], covered[0] * 0.75);
+  EXPECT_NEAR(covered[14], covered[1], covered[0] * 0.05);  // sin(2 pi 14/30) = sin(2 pi/30)
+  // The first frame equals a render of the mesh on its own.
+  const std::string single = R"({"mesh": )" + requestMeshJson(torus.mesh) +
+                             R"(, "camera": {"eye": [0.5, -4, 3], "width": 128, "height": 128},
+      "method": "patches", "params": {"dicingRate": 4}, "outputs": ["mask"]})";
+  HttpResponse one = post(port(), "/v1/render", single);
+  ASSERT_EQ(one.status, 200);
+  auto oneDoc = parseJson(one.body);
+  EXPECT_EQ(oneDoc["stats"]["triangles"].GetUint64(), doc["frames"][0]["triangles"].GetUint64());
+}
+
+TEST_F(PatchesEndpointTest, BadFramesNameTheField) {
+  const NamedMesh cube = selectShapes(ownShapes(), {"own_cube"})[0];
+  auto request = [&](const std::string& method, const std::string& frames,
+                     const std::string& extra = "") {
+    return R"({"mesh": )" + requestMeshJson(cube.mesh) +
+           R"(, "camera": {"width": 64, "height": 64}, "method": ")" + method + R"(", "frames": )" +
+           frames + extra + "}";
+  };
+  const std::string two = breathingFrames(cube.mesh, 2);
+  struct Case {
+    std::string body;
+    int status;
+    const char* field;
+  };
+  const std::vector<Case> cases = {
+      {request("adaptive", two), 400, "frames"},
+      {request("patches", "[]"), 400, "frames"},
+      {request("patches", "[[[0, 0, 0]]]"), 400, "frames[0]"},
+      {request("patches", "{}"), 400, "frames"},
+      {request("patches", two, R"(, "reference": true)"), 400, "reference"},
+      {request("patches", breathingFrames(cube.mesh, 121)), 413, "frames"},
+  };
+  for (const Case& c : cases) {
+    HttpResponse r = post(port(), "/v1/render", c.body);
+    EXPECT_EQ(r.status, c.status) << r.body.substr(0, 300);
+    EXPECT_EQ(errorField(r), c.field) << r.body.substr(0, 300);
   }
 }
 

@@ -883,7 +883,7 @@ render::pipeline::RenderResult handMadeResult() {
   timings.reference = render::oracle::ReferenceStats{};
   timings.reference->sceneCached = true;
   timings.reference->newtonMs = 1.5;
-  return {images, reference, metrics, stats, timings, {"engine note"}, camera};
+  return {images, reference, metrics, stats, timings, {"engine note"}, camera, {}};
 }
 
 TEST(RenderResponse, HasTheDesignShape) {
