@@ -213,6 +213,7 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
   count("domains", s.tessellation.domains);
   count("transitionEdges", s.tessellation.transitionEdges);
   count("clampedEdges", s.tessellation.clampedEdges);
+  numberField(w, "dicingRate", s.tessellation.dicingRate);
   numberField(w, "tableMs", s.tableMs);
   numberField(w, "tessellateMs", s.tessellateMs);
   w.EndObject();

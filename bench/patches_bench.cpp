@@ -15,9 +15,9 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
-#include <thread>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "render/patches/patch_set.h"
@@ -59,11 +59,16 @@ Options parse(int argc, char** argv) {
     }
     if (i + 1 >= argc) throw std::runtime_error("missing value after " + flag);
     std::string value = argv[++i];
-    if (flag == "--size") o.size = std::stoi(value);
-    else if (flag == "--views") o.views = std::stoi(value);
-    else if (flag == "--seed") o.seed = std::stoull(value);
-    else if (flag == "--frames") o.frames = std::stoi(value);
-    else if (flag == "--shapes") o.shapes = split(value);
+    if (flag == "--size")
+      o.size = std::stoi(value);
+    else if (flag == "--views")
+      o.views = std::stoi(value);
+    else if (flag == "--seed")
+      o.seed = std::stoull(value);
+    else if (flag == "--frames")
+      o.frames = std::stoi(value);
+    else if (flag == "--shapes")
+      o.shapes = split(value);
     else if (flag == "--rates") {
       o.rates.clear();
       for (const std::string& r : split(value)) o.rates.push_back(std::stod(r));
@@ -89,10 +94,12 @@ double uniformFaces(const mesh::ControlMesh& m, int level) {
 
 void printPatchCounts(const std::vector<testing::NamedMesh>& shapes) {
   std::printf("## Patches per isolation level against uniform faces\n\n");
-  std::printf("Each cell: patches at that isolation / faces of uniform refinement at that "
-              "level. Build: topology, adaptive refinement, patch table and point stencils.\n\n");
-  std::printf("| shape | faces | iso 1 | iso 2 | iso 3 | iso 4 | iso 5 | iso 6 | build ms iso 4 | "
-              "build ms iso 6 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "Each cell: patches at that isolation / faces of uniform refinement at that "
+      "level. Build: topology, adaptive refinement, patch table and point stencils.\n\n");
+  std::printf(
+      "| shape | faces | iso 1 | iso 2 | iso 3 | iso 4 | iso 5 | iso 6 | build ms iso 4 | "
+      "build ms iso 6 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const testing::NamedMesh& shape : shapes) {
     try {
       std::printf("| %s | %d", shape.name.c_str(), shape.mesh.faceCount());
@@ -128,18 +135,19 @@ double median(std::vector<double> v) {
 void printComparison(const std::vector<testing::NamedMesh>& shapes, const Options& options,
                      pipeline::RenderContext& context) {
   std::printf("## patches against adaptive at the same dicing rate\n\n");
-  std::printf("%d random views per shape at %d x %d (seed %llu), S = 4; medians over the views, "
-              "worst px in brackets. Time: approximation only (the raster is the same work per "
-              "triangle). adaptive caps an edge at 128 segments per face edge; patches cut large "
-              "patches into domains, so at small rates it makes the triangles the rate asks "
-              "for.\n\n",
-              options.views, options.size, options.size,
-              static_cast<unsigned long long>(options.seed));
+  std::printf(
+      "%d random views per shape at %d x %d (seed %llu), S = 4; medians over the views, "
+      "worst px in brackets. Time: approximation only (the raster is the same work per "
+      "triangle). adaptive caps an edge at 128 segments per face edge; patches cut large "
+      "patches into domains, so at small rates it makes the triangles the rate asks "
+      "for.\n\n",
+      options.views, options.size, options.size, static_cast<unsigned long long>(options.seed));
   std::printf("| shape | faces |");
   for (double rate : options.rates) {
-    std::printf(" adaptive:%g tris | patches:%g tris | adaptive ms | patches ms | adaptive px | "
-                "patches px |",
-                rate, rate);
+    std::printf(
+        " adaptive:%g tris | patches:%g tris | adaptive ms | patches ms | adaptive px | "
+        "patches px |",
+        rate, rate);
   }
   std::printf("\n|---|---:|");
   for (size_t r = 0; r < options.rates.size(); ++r) std::printf("---:|---:|---:|---:|---:|---:|");
@@ -150,9 +158,9 @@ void printComparison(const std::vector<testing::NamedMesh>& shapes, const Option
     pipeline::CompareJob job;
     job.mesh = shape.mesh;
     subdiv::LimitSurface surface(shape.mesh);
-    for (const auto& view : testing::randomViews(surface.bounds(), options.views,
-                                                 testing::viewSeed(options.seed, shape.name),
-                                                 options.size)) {
+    for (const auto& view :
+         testing::randomViews(surface.bounds(), options.views,
+                              testing::viewSeed(options.seed, shape.name), options.size)) {
       job.cameras.push_back(view.camera);
     }
     for (double rate : options.rates) {
@@ -196,10 +204,10 @@ void printComparison(const std::vector<testing::NamedMesh>& shapes, const Option
     std::fprintf(stderr, "%s done\n", shape.name.c_str());
   }
   if (ratioCount > 0) {
-    std::printf("\nAt dicing rate %g: patches make %.2fx the triangles of adaptive and take %.2fx "
-                "its time (mean over %d shapes).\n\n",
-                options.rates.front(), ratioSum / ratioCount, timeRatioSum / ratioCount,
-                ratioCount);
+    std::printf(
+        "\nAt dicing rate %g: patches make %.2fx the triangles of adaptive and take %.2fx "
+        "its time (mean over %d shapes).\n\n",
+        options.rates.front(), ratioSum / ratioCount, timeRatioSum / ratioCount, ratioCount);
   }
 }
 
@@ -222,13 +230,16 @@ std::vector<Vec3> breathing(const mesh::ControlMesh& rest, const Bounds& bounds,
 
 void printAnimation(const Options& options) {
   std::printf("## Animation: keeping the table against rebuilding it\n\n");
-  std::printf("%d frames of a breathing and bending mesh, %d x %d, dicing rate 4, isolation 4 and 6. Per frame: "
-              "kept = new control points (stencils) + tessellation; rebuilt = topology, "
-              "refinement, patch table, stencils + tessellation. Raster and reference are the "
-              "same work either way and left out.\n\n",
-              options.frames, options.size, options.size);
-  std::printf("| mesh | faces | isolation | kept ms/frame | rebuilt ms/frame | rebuilt / kept | "
-              "of which table ms |\n|---|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "%d frames of a breathing and bending mesh, %d x %d, dicing rate 4, isolation 4 and 6. Per "
+      "frame: "
+      "kept = new control points (stencils) + tessellation; rebuilt = topology, "
+      "refinement, patch table, stencils + tessellation. Raster and reference are the "
+      "same work either way and left out.\n\n",
+      options.frames, options.size, options.size);
+  std::printf(
+      "| mesh | faces | isolation | kept ms/frame | rebuilt ms/frame | rebuilt / kept | "
+      "of which table ms |\n|---|---:|---:|---:|---:|---:|---:|\n");
   for (auto [name, rest] : {std::pair{"torus 24x12", testing::torus(24, 12, false)},
                             std::pair{"pawn 588", testing::pawn()},
                             std::pair{"bumpy ball 1536", testing::bumpyBall()}}) {

@@ -30,8 +30,10 @@ enum class PatchKind { Regular, Boundary, Crease, Irregular };
 inline constexpr int kPatchKinds = 4;
 const char* patchKindName(PatchKind kind);
 
-// The isolation "auto" picks, and the most a request may ask for.
-inline constexpr int kDefaultIsolation = 4;
+// The default isolation: Bfr's (subdiv::kApproxLevel), so the patches are the limit surface the
+// reference draws; lower levels approximate it near extraordinary vertices, semi-sharp creases
+// and sharp corners (bench/patches_results.md). And the most a request may ask for.
+inline constexpr int kDefaultIsolation = 6;
 inline constexpr int kMaxIsolation = 8;
 
 struct Patch {

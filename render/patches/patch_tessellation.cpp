@@ -301,6 +301,11 @@ size_t insideTriangles(const Domain& patch, const Ring& ring, int maxFactor) {
   return (patch.triangle ? n * n : 2 * n * n) + sum;
 }
 
+// Thrown by Tessellator::run() when the factors would make more than maxTriangles.
+struct OverBudget {
+  size_t triangles;
+};
+
 class Tessellator {
  public:
   Tessellator(const PatchSet& set, const Camera& camera, const TessellationOptions& options,
@@ -323,12 +328,7 @@ class Tessellator {
       rings[p] = ringOf(p);
       triangles += insideTriangles(patches[p], rings[p], options_.maxEdgeFactor);
     }
-    if (triangles > options_.maxTriangles) {
-      throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
-                       "patches tessellation would make " + std::to_string(triangles) +
-                           " triangles: exceeds limit maxTriangles " +
-                           std::to_string(options_.maxTriangles) + " (raise params.dicingRate)");
-    }
+    if (triangles > options_.maxTriangles) throw OverBudget{triangles};
     std::vector<PatchInside> insides(patches.size());
     parallelFor(patches.size(), 64, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
@@ -468,17 +468,25 @@ class Tessellator {
     out.push_back({from, to, a, b});
   }
 
-  // Segments of one piece: its projected length over the dicing rate, from the welded end
-  // points only, so both patches sharing the piece compute the same number. A piece crossing
-  // the eye plane is as fine as allowed.
-  int segmentsOf(const Piece& piece) {
+  // Segments of one piece: the projected length of its end-midpoint-end polyline over the
+  // dicing rate (the midpoint matters along the outline, where the chord is foreshortened but
+  // the curve still bulges sideways). Computed once per piece, by the first patch that needs it:
+  // the other side reuses the vertices, so both agree. A piece crossing the eye plane is as
+  // fine as allowed.
+  int segmentsOf(const Domain& patch, const Piece& piece) {
     const Vec3 a = camera_.project(positions_[piece.from]);
     const Vec3 b = camera_.project(positions_[piece.to]);
-    double wanted = std::ceil(std::hypot(a.x - b.x, a.y - b.y) / options_.dicingRate);
+    const Vec3 m =
+        camera_.project(evaluateSample(set_, patch, lerp(piece.a, piece.b, 0.5)).position);
+    double wanted =
+        std::ceil((std::hypot(a.x - m.x, a.y - m.y) + std::hypot(m.x - b.x, m.y - b.y)) /
+                  options_.dicingRate);
     if (camera_.projection() == Projection::Perspective) {
       const bool aBehind = a.z <= camera_.nearPlane(), bBehind = b.z <= camera_.nearPlane();
       if (aBehind && bBehind) wanted = 1;
-      if (aBehind != bBehind) wanted = options_.maxEdgeFactor;
+      if (aBehind != bBehind || (m.z <= camera_.nearPlane()) != aBehind) {
+        wanted = options_.maxEdgeFactor;
+      }
     }
     if (wanted > options_.maxEdgeFactor) ++stats_.clampedEdges;
     return static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options_.maxEdgeFactor)));
@@ -491,7 +499,7 @@ class Tessellator {
     const std::pair<int, int> key = std::minmax(piece.from, piece.to);
     auto it = edgeVertices_.find(key);
     if (it == edgeVertices_.end()) {
-      const int segments = segmentsOf(piece);
+      const int segments = segmentsOf(patch, piece);
       std::vector<int> ids;
       for (int k = 1; k < segments; ++k) {
         const double t = static_cast<double>(k) / segments;
@@ -647,7 +655,24 @@ bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& 
 
 PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
                             const TessellationOptions& options, const CancelToken& cancel) {
-  return Tessellator(patches, camera, options, cancel).run();
+  TessellationOptions tried = options;
+  for (int attempt = 0;; ++attempt) {
+    try {
+      PatchMesh out = Tessellator(patches, camera, tried, cancel).run();
+      out.stats.dicingRate = tried.dicingRate;
+      return out;
+    } catch (const OverBudget& over) {
+      if (!options.fitToBudget || attempt == 3) {
+        throw InputError(InputError::Kind::LimitExceeded, "maxTriangles",
+                         "patches tessellation would make " + std::to_string(over.triangles) +
+                             " triangles: exceeds limit maxTriangles " +
+                             std::to_string(options.maxTriangles) + " (raise params.dicingRate)");
+      }
+      // Triangles grow as the square of the segments: coarsen by the square root, and a bit.
+      tried.dicingRate *= 1.05 * std::sqrt(static_cast<double>(over.triangles) /
+                                           static_cast<double>(options.maxTriangles));
+    }
+  }
 }
 
 }  // namespace limn::render::patches

@@ -27,6 +27,9 @@ struct TessellationOptions {
   int maxEdgeFactor = 64;   // segments per patch edge at most
   bool cullHidden = true;
   size_t maxTriangles = 8'000'000;
+  // Over maxTriangles: true coarsens the dicing rate until the mesh fits (reported in
+  // TessellationStats::dicingRate); false throws InputError(LimitExceeded).
+  bool fitToBudget = false;
 };
 
 struct TessellationStats {
@@ -37,6 +40,7 @@ struct TessellationStats {
   size_t domains = 0;           // the units tessellated: whole patches and parts of split ones
   size_t transitionEdges = 0;   // domain edges split where a finer neighbour meets them
   size_t clampedEdges = 0;      // edge pieces that wanted more than maxEdgeFactor segments
+  double dicingRate = 0;        // the rate used (coarser than asked when fitted to the budget)
 };
 
 struct PatchMesh {
@@ -46,7 +50,7 @@ struct PatchMesh {
 };
 
 // Throws InputError(LimitExceeded, "maxTriangles") before evaluating the inside of any patch
-// when the factors would make more than maxTriangles, and Cancelled.
+// when the factors would make more than maxTriangles (unless fitToBudget), and Cancelled.
 PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
                             const TessellationOptions& options, const CancelToken& cancel);
 

@@ -1,5 +1,6 @@
 #include "render/pipeline/drawing.h"
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -81,6 +82,12 @@ tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobL
                          " is not tessellated here");
 }
 
+std::string formatRate(double rate) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", rate);
+  return text;
+}
+
 }  // namespace
 
 void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
@@ -92,7 +99,16 @@ void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice
   options.dicingRate = choice.params.dicingRate;
   options.cullHidden = choice.params.cullPatches;
   options.maxTriangles = limits.maxTriangles;
+  // At 1 px and 1024^2 a coarse Loop mesh would ask for 10M+ triangles (adaptive caps its
+  // faces' edges at 128 segments instead): the rate is coarsened to fit, and said.
+  options.fitToBudget = true;
   patches::PatchMesh tessellation = patches::tessellatePatches(set, camera, options, cancel);
+  if (tessellation.stats.dicingRate > options.dicingRate) {
+    out.warnings.push_back("params.dicingRate raised from " + formatRate(options.dicingRate) +
+                           " to " + formatRate(tessellation.stats.dicingRate) +
+                           " px to stay within maxTriangles (" +
+                           std::to_string(limits.maxTriangles) + ")");
+  }
   stats.tessellation = tessellation.stats;
   stats.tessellateMs = clock.lapMs();
   if (tessellation.stats.clampedEdges > 0) {

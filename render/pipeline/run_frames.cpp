@@ -25,8 +25,8 @@ void checkFrames(const RenderJob& job, const JobLimits& limits) {
   }
   if (job.frames.size() > limits.maxFrames) {
     throw InputError(InputError::Kind::LimitExceeded, "maxFrames",
-                     "frames: " + std::to_string(job.frames.size()) +
-                         " exceed limit maxFrames (" + std::to_string(limits.maxFrames) + ")");
+                     "frames: " + std::to_string(job.frames.size()) + " exceed limit maxFrames (" +
+                         std::to_string(limits.maxFrames) + ")");
   }
   const Outputs& o = job.outputs;
   const size_t passes = o.color + o.mask + o.depth + o.normal + o.wireframe + o.cage + o.patches;
@@ -37,7 +37,8 @@ void checkFrames(const RenderJob& job, const JobLimits& limits) {
     throw InputError(InputError::Kind::LimitExceeded, "maxFramePixels",
                      "frames: " + std::to_string(pixels) +
                          " image pixels (frames x width x height x outputs) exceed limit "
-                         "maxFramePixels (" + std::to_string(limits.maxFramePixels) + ")");
+                         "maxFramePixels (" +
+                         std::to_string(limits.maxFramePixels) + ")");
   }
   for (size_t f = 0; f < job.frames.size(); ++f) {
     if (job.frames[f].size() != job.mesh.points.size()) {
@@ -79,7 +80,8 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
     const MethodChoice choice{frameMesh, job.method, job.params, job.shading, outputs};
     Approximated approx;
     tessellatePatchSet(set, choice, limits, result.camera, cancel, approx);
-    if (job.outputs.cage) approx.overlays.push_back(tessellate::cageOverlay(frameMesh, pass::kCage));
+    if (job.outputs.cage)
+      approx.overlays.push_back(tessellate::cageOverlay(frameMesh, pass::kCage));
     approx.stats.triangles = approx.mesh.triangleCount();
     approx.stats.vertices = approx.mesh.vertexCount();
     const double approxMs = frameClock.lapMs();
@@ -90,8 +92,8 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
       result.stats.patchTable = approx.stats.patchTable;
     }
     result.warnings.insert(result.warnings.end(), approx.warnings.begin(), approx.warnings.end());
-    MethodDrawing drawing = rasterizeApproximation(std::move(approx), choice, surface, result.camera,
-                                                   context, false, 0, cancel);
+    MethodDrawing drawing = rasterizeApproximation(std::move(approx), choice, surface,
+                                                   result.camera, context, false, 0, cancel);
     result.frames.push_back({.images = selectOutputs(std::move(drawing.images), job.outputs, false),
                              .triangles = drawing.approx.stats.triangles,
                              .approxMs = approxMs,

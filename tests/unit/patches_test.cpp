@@ -196,11 +196,12 @@ TEST(PatchTessellation, TrianglesFaceTheWayTheirNormalsDo) {
   }
 }
 
-TEST(PatchTessellation, FinerDicingMakesMoreTrianglesAndTheBudgetIsHonoured) {
+TEST(PatchTessellation, FinerDicingMakesMoreTrianglesAndTheBudgetIsHonouredOrFitted) {
   const ControlMesh m = limn::testing::torus(12, 8, true);
   PatchSet set(m, 3, CancelToken());
   Camera camera = viewOf(set, 0, 1024);
   TessellationOptions coarse, fine;
+  fine.cullHidden = false;
   coarse.dicingRate = 8;
   fine.dicingRate = 1;
   size_t few = tessellatePatches(set, camera, coarse, CancelToken()).mesh.triangleCount();
@@ -208,6 +209,12 @@ TEST(PatchTessellation, FinerDicingMakesMoreTrianglesAndTheBudgetIsHonoured) {
   EXPECT_GT(many, few * 8);
   fine.maxTriangles = many / 2;
   EXPECT_THROW(tessellatePatches(set, camera, fine, CancelToken()), InputError);
+  fine.fitToBudget = true;
+  PatchMesh fitted = tessellatePatches(set, camera, fine, CancelToken());
+  EXPECT_LE(fitted.mesh.triangleCount(), fine.maxTriangles);
+  EXPECT_GT(fitted.mesh.triangleCount(), fine.maxTriangles / 4);
+  EXPECT_GT(fitted.stats.dicingRate, 1.2);
+  expectWatertight(fitted.mesh, "fitted");
 }
 
 TEST(PatchCulling, DropsOnlyPatchesOutsideTheViewOrFacingAwayEverywhere) {
