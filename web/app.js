@@ -85,6 +85,9 @@ function methodParams() {
   const method = $("method").value;
   if (method === "uniform") return { level: Number($("level").value), engine: $("engine").value };
   if (method === "adaptive") return { dicingRate: Number($("dicing-rate").value) };
+  if (method === "patches") {
+    return { dicingRate: Number($("patch-dicing-rate").value), isolation: Number($("isolation").value) };
+  }
   if (method === "silhouette") {
     const p = $("presubdivide").value;
     return { contour: $("contour-mode").value, presubdivide: p === "auto" ? "auto" : Number(p) };
@@ -94,6 +97,7 @@ function methodParams() {
 
 // The image the view shows: the cage drawn over the surface, or its wireframe, or its colour.
 function mainOutput() {
+  if ($("method").value === "patches" && $("show-patches").checked) return "patches";
   if ($("draw-cage").checked && $("method").value !== "limit") return "cage";
   if ($("draw-wireframe").checked) return "wireframe";
   return "color";
@@ -696,6 +700,7 @@ function bindControls() {
   $("level").addEventListener("input", () => { $("level-value").textContent = $("level").value; });
   $("method").addEventListener("change", showMethodParams);
   for (const id of ["method", "level", "engine", "dicing-rate", "contour-mode", "presubdivide",
+                    "patch-dicing-rate", "isolation", "show-patches",
                     "draw-surface", "draw-cage", "draw-wireframe", "shading", "size",
                     "polygonizer", "resolution", "flatness"]) {
     $(id).addEventListener("change", renderFull);

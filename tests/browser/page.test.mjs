@@ -369,4 +369,22 @@ describe("limn's page", () => {
     assert.ok(await page.isVisible("#method"), "the method control did not come back");
     assert.ok(!(await page.isVisible("#polygonizer")), "the polygoniser controls stayed");
   });
+
+  it("draws feature-adaptive patches, and colours them by level on request", async () => {
+    let n = await set("#compare", false);
+    await waitForRenders(n + 1);
+    n = await set("#method", "patches");
+    await waitForRenders(n + 1);
+    assert.ok(await page.isVisible("#isolation"), "the patch controls are hidden");
+    const stats = await page.evaluate(() => window.limnPage.lastAnswer.stats);
+    assert.ok(stats.patchTable && stats.patchTable.patches > 0, "no patch table in the answer");
+    assert.equal(stats.patchTable.isolation, 6);
+    await keepPixels("#picture", "patchesShaded");
+    n = await set("#show-patches", true);
+    await waitForRenders(n + 1);
+    await keepPixels("#picture", "patchesByLevel");
+    const changed = await differingFraction("patchesShaded", "patchesByLevel");
+    assert.ok(changed > 0.05, `the patch colours changed only ${(100 * changed).toFixed(2)}%`);
+    await shot("patches-by-level", page.locator("#view"));
+  });
 });
