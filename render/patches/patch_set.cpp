@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/subdiv/far_patch_surface.h"
 #include "render/subdiv/far_point.h"
 #include "render/subdiv/limit_surface.h"
 
@@ -21,20 +22,6 @@ namespace {
 
 // The most points a patch has (a quad Gregory basis patch).
 constexpr int kMaxPatchPoints = 20;
-
-// Options shared with Bfr's own patch trees (and subdiv::FarPatchSurface): infinitely sharp
-// features as patches, Gregory bases for what stays irregular, smooth corners kept smooth.
-Far::PatchTableFactory::Options tableOptions(int isolation) {
-  Far::PatchTableFactory::Options options(isolation);
-  options.SetEndCapType(Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
-  options.useInfSharpPatch = true;
-  options.useSingleCreasePatch = false;
-  options.generateLegacySharpCornerPatches = false;
-  options.generateVaryingTables = false;
-  options.generateVaryingLocalPoints = false;
-  options.SetPatchPrecision<double>();
-  return options;
-}
 
 // Stencils from the control points to every refined point, then to every end-cap point.
 std::unique_ptr<const Far::StencilTableReal<double>> pointStencils(
@@ -106,7 +93,7 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
   }
   cancel.check();
 
-  Far::PatchTableFactory::Options options = tableOptions(isolation);
+  Far::PatchTableFactory::Options options = subdiv::bfrPatchOptions(isolation);
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
   adaptive.secondaryLevel = isolation;
   refiner->RefineAdaptive(adaptive);

@@ -194,6 +194,22 @@ struct Ring {
   int segments(int side) const { return static_cast<int>(ids[side].size()) - 1; }
 };
 
+// Each side of the outer ring zipped to the same side of the inner one, given as grid points
+// (i, j) that `interiorId` numbers and `at` places.
+template <size_t Sides, typename Id, typename At>
+void zipRing(const Ring& ring, const std::array<std::vector<std::array<int, 2>>, Sides>& sides,
+             const Id& interiorId, const At& at, PatchInside& out) {
+  for (size_t k = 0; k < Sides; ++k) {
+    std::vector<int> ids;
+    std::vector<Vec2> local;
+    for (auto [i, j] : sides[k]) {
+      ids.push_back(interiorId(i, j));
+      local.push_back(at(i, j));
+    }
+    zip(ring.ids[k], ring.at[k], ids, local, out);
+  }
+}
+
 void tessellateQuadInside(const Ring& ring, int maxFactor, PatchInside& out) {
   const std::array<int, 4> seg = {ring.segments(0), ring.segments(1), ring.segments(2),
                                   ring.segments(3)};
@@ -228,15 +244,7 @@ void tessellateQuadInside(const Ring& ring, int maxFactor, PatchInside& out) {
   for (int j = 1; j < iv; ++j) sides[1].push_back({iu - 1, j});
   for (int i = iu - 1; i >= 1; --i) sides[2].push_back({i, iv - 1});
   for (int j = iv - 1; j >= 1; --j) sides[3].push_back({1, j});
-  for (int k = 0; k < 4; ++k) {
-    std::vector<int> ids;
-    std::vector<Vec2> local;
-    for (auto [i, j] : sides[k]) {
-      ids.push_back(interiorId(i, j));
-      local.push_back(at(i, j));
-    }
-    zip(ring.ids[k], ring.at[k], ids, local, out);
-  }
+  zipRing(ring, sides, interiorId, at, out);
 }
 
 void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out) {
@@ -278,15 +286,7 @@ void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out)
   for (int i = 1; i <= n - 2; ++i) sides[0].push_back({i, 1});
   for (int j = 1; j <= n - 2; ++j) sides[1].push_back({n - 1 - j, j});
   for (int j = n - 2; j >= 1; --j) sides[2].push_back({1, j});
-  for (int k = 0; k < 3; ++k) {
-    std::vector<int> ids;
-    std::vector<Vec2> local;
-    for (auto [i, j] : sides[k]) {
-      ids.push_back(interiorId(i, j));
-      local.push_back(at(i, j));
-    }
-    zip(ring.ids[k], ring.at[k], ids, local, out);
-  }
+  zipRing(ring, sides, interiorId, at, out);
 }
 
 // Triangles the inside of a patch will make (checked against the budget before evaluating).

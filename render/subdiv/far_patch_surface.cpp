@@ -26,17 +26,8 @@ double clampUnit(double x) { return std::clamp(x, 0.0, 1.0); }
 
 }  // namespace
 
-FarPatchSurface::FarPatchSurface(std::unique_ptr<Far::TopologyRefiner> refiner,
-                                 const std::vector<int>& faces, const std::vector<Vec3>& points) {
-  Far::PtexIndices ptexIndices(*refiner);
-  const int baseFaces = refiner->GetLevel(0).GetNumFaces();
-  firstPtexFace_.resize(baseFaces);
-  for (int f = 0; f < baseFaces; ++f) firstPtexFace_[f] = ptexIndices.GetFaceId(f);
-
-  // Bfr's choices (Bfr::PatchTreeBuilder): both isolation levels at kApproxLevel, infinitely
-  // sharp features as patches, Gregory bases for what stays irregular, and smooth corners kept
-  // smooth rather than Far's legacy sharp patches.
-  Far::PatchTableFactory::Options options(kApproxLevel);
+Far::PatchTableFactory::Options bfrPatchOptions(int isolation) {
+  Far::PatchTableFactory::Options options(isolation);
   options.SetEndCapType(Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
   options.useInfSharpPatch = true;
   options.useSingleCreasePatch = false;
@@ -44,6 +35,18 @@ FarPatchSurface::FarPatchSurface(std::unique_ptr<Far::TopologyRefiner> refiner,
   options.generateVaryingTables = false;
   options.generateVaryingLocalPoints = false;
   options.SetPatchPrecision<double>();
+  return options;
+}
+
+FarPatchSurface::FarPatchSurface(std::unique_ptr<Far::TopologyRefiner> refiner,
+                                 const std::vector<int>& faces, const std::vector<Vec3>& points) {
+  Far::PtexIndices ptexIndices(*refiner);
+  const int baseFaces = refiner->GetLevel(0).GetNumFaces();
+  firstPtexFace_.resize(baseFaces);
+  for (int f = 0; f < baseFaces; ++f) firstPtexFace_[f] = ptexIndices.GetFaceId(f);
+
+  // Both isolation levels at kApproxLevel, as Bfr.
+  Far::PatchTableFactory::Options options = bfrPatchOptions(kApproxLevel);
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
   adaptive.secondaryLevel = kApproxLevel;
   Far::ConstIndexArray selected(faces.data(), static_cast<int>(faces.size()));

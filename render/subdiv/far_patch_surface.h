@@ -14,6 +14,7 @@
 #include <opensubdiv/bfr/parameterization.h>
 #include <opensubdiv/far/patchMap.h>
 #include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/patchTableFactory.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
 #include <memory>
@@ -22,6 +23,11 @@
 #include "render/core/vec.h"
 
 namespace limn::render::subdiv {
+
+// Far's patch-table options as Bfr sets up its own per-face patch trees (Bfr::PatchTreeBuilder),
+// at `isolation`: infinitely sharp features as patches, Gregory bases for what stays irregular,
+// smooth corners kept smooth rather than Far's legacy sharp patches, double precision.
+OpenSubdiv::Far::PatchTableFactory::Options bfrPatchOptions(int isolation);
 
 class FarPatchSurface {
  public:

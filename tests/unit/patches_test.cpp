@@ -19,26 +19,6 @@ namespace {
 
 using mesh::ControlMesh;
 
-// A pentagonal prism, unsplit: its caps are Catmull-Clark n-gons (Ptex sub-faces).
-ControlMesh pentagonalPrism() {
-  ControlMesh m;
-  const int n = 5;
-  for (int k = 0; k < n; ++k) {
-    double a = 2 * std::numbers::pi * k / n;
-    m.points.push_back({std::cos(a), std::sin(a), -0.6});
-    m.points.push_back({std::cos(a), std::sin(a), 0.6});
-  }
-  for (int k = 0; k < n; ++k) {
-    int next = (k + 1) % n;
-    limn::testing::addFace(m, {2 * k, 2 * next, 2 * next + 1, 2 * k + 1});
-  }
-  m.faceVertexCounts.push_back(n);
-  for (int k = 0; k < n; ++k) m.faceVertexIndices.push_back(2 * (n - 1 - k));
-  m.faceVertexCounts.push_back(n);
-  for (int k = 0; k < n; ++k) m.faceVertexIndices.push_back(2 * k + 1);
-  return m;
-}
-
 std::vector<std::pair<std::string, ControlMesh>> closedMeshes() {
   using namespace limn::testing;
   return {{"cube", cube()},
@@ -46,7 +26,7 @@ std::vector<std::pair<std::string, ControlMesh>> closedMeshes() {
           {"semi-sharp cube", semiSharpCube()},
           {"cube with sharp corners", cubeWithSharpCorners()},
           {"creased torus", torus(12, 8, true)},
-          {"pentagonal prism", pentagonalPrism()},
+          {"pentagonal prism", prism(5)},
           {"loop icosahedron", icosahedron()},
           {"sharp loop tetrahedron", sharpTetrahedron()}};
 }

@@ -377,9 +377,8 @@ inline ControlMesh splitOnce(const ControlMesh& m) {
   return out;
 }
 
-// An n-sided prism, split once: its two cap centres have valence n, its corners 3 (edge tables
-// of every valence, issue 10).
-inline ControlMesh splitPrism(int n) {
+// An n-sided prism (its caps are n-gons).
+inline ControlMesh prism(int n) {
   ControlMesh m;
   for (int k = 0; k < n; ++k) {
     double a = 2 * std::numbers::pi * k / n;
@@ -399,8 +398,12 @@ inline ControlMesh splitPrism(int n) {
   m.faceVertexIndices.insert(m.faceVertexIndices.end(), bottom.begin(), bottom.end());
   m.faceVertexCounts.push_back(n);
   m.faceVertexIndices.insert(m.faceVertexIndices.end(), top.begin(), top.end());
-  return displaced(splitOnce(m));
+  return m;
 }
+
+// An n-sided prism, split once: its two cap centres have valence n, its corners 3 (edge tables
+// of every valence, issue 10).
+inline ControlMesh splitPrism(int n) { return displaced(splitOnce(prism(n))); }
 
 // An n-sided bipyramid of triangles (Loop), split once: its apices have valence n.
 inline ControlMesh splitBipyramid(int n) {
