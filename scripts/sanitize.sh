@@ -9,6 +9,7 @@ scripts/setup.sh
 jobs="${LIMN_JOBS:-$(nproc)}"
 # bench/ is left out: benchmarks under sanitizers measure nothing.
 modules="render/core;render/mesh;render/subdiv;render/normalmap;render/rules;render/tessellate"
+modules+=";render/patches"
 modules+=";render/implicit"
 modules+=";render/silhouette;render/image;render/raster;render/metrics;render/oracle"
 modules+=";render/pipeline;api;batch;tests/support;server;tests/integration;fuzz"
