@@ -52,9 +52,11 @@ class Welder {
 
  private:
   std::array<int64_t, 3> cellOf(const Vec3& p) const {
-    return {static_cast<int64_t>(std::floor(p.x / cell_)),
-            static_cast<int64_t>(std::floor(p.y / cell_)),
-            static_cast<int64_t>(std::floor(p.z / cell_))};
+    // Clamped so that a degenerate mesh (a tiny diagonal, hence tiny cells) cannot overflow.
+    auto cell = [&](double x) {
+      return static_cast<int64_t>(std::clamp(std::floor(x / cell_), -1e18, 1e18));
+    };
+    return {cell(p.x), cell(p.y), cell(p.z)};
   }
   static uint64_t key(const std::array<int64_t, 3>& c) {
     return (static_cast<uint64_t>(c[0]) * 73856093u) ^ (static_cast<uint64_t>(c[1]) * 19349663u) ^
@@ -290,15 +292,15 @@ void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out)
 }
 
 // Triangles the inside of a patch will make (checked against the budget before evaluating).
-size_t insideTriangles(const Domain& patch, const Ring& ring, int maxFactor) {
+size_t insideTriangles(const Domain& domain, const Ring& ring, int maxFactor) {
   int most = 1, sum = 0;
   for (size_t k = 0; k < ring.ids.size(); ++k) {
     most = std::max(most, ring.segments(static_cast<int>(k)));
     sum += ring.segments(static_cast<int>(k));
   }
-  if (most == 1) return patch.triangle ? 1 : 2;
+  if (most == 1) return domain.triangle ? 1 : 2;
   const size_t n = std::min(most, maxFactor);
-  return (patch.triangle ? n * n : 2 * n * n) + sum;
+  return (domain.triangle ? n * n : 2 * n * n) + sum;
 }
 
 // Thrown by Tessellator::run() when the factors would make more than maxTriangles.
@@ -319,29 +321,29 @@ class Tessellator {
   PatchMesh run() {
     chooseCulled();
     makeDomains();
-    const std::vector<Domain>& patches = domains_;
+    const std::vector<Domain>& domains = domains_;
     weldCorners();
-    std::vector<Ring> rings(patches.size());
+    std::vector<Ring> rings(domains.size());
     size_t triangles = 0;
-    for (size_t p = 0; p < patches.size(); ++p) {
+    for (size_t p = 0; p < domains.size(); ++p) {
       if (p % kPatchesBetweenChecks == 0) cancel_.check();
       rings[p] = ringOf(p);
-      triangles += insideTriangles(patches[p], rings[p], options_.maxEdgeFactor);
+      triangles += insideTriangles(domains[p], rings[p], options_.maxEdgeFactor);
     }
     if (triangles > options_.maxTriangles) throw OverBudget{triangles};
-    std::vector<PatchInside> insides(patches.size());
-    parallelFor(patches.size(), 64, [&](size_t begin, size_t end) {
+    std::vector<PatchInside> insides(domains.size());
+    parallelFor(domains.size(), 64, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
         if (p % kPatchesBetweenChecks == 0) cancel_.check();
         PatchInside& in = insides[p];
-        if (patches[p].triangle) {
+        if (domains[p].triangle) {
           tessellateTriangleInside(rings[p], options_.maxEdgeFactor, in);
         } else {
           tessellateQuadInside(rings[p], options_.maxEdgeFactor, in);
         }
         in.samples.reserve(in.interior.size());
         for (const Vec2& ab : in.interior)
-          in.samples.push_back(evaluateSample(set_, patches[p], ab));
+          in.samples.push_back(evaluateSample(set_, domains[p], ab));
       }
     });
     cancel_.check();
@@ -356,18 +358,18 @@ class Tessellator {
   }
 
   void weldCorners() {
-    const std::vector<Domain>& patches = domains_;
-    std::vector<std::array<Sample, 4>> samples(patches.size());
-    parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
+    const std::vector<Domain>& domains = domains_;
+    std::vector<std::array<Sample, 4>> samples(domains.size());
+    parallelFor(domains.size(), 256, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
-        for (int k = 0; k < cornerCount(patches[p]); ++k) {
-          samples[p][k] = evaluateSample(set_, patches[p], corner(patches[p], k));
+        for (int k = 0; k < cornerCount(domains[p]); ++k) {
+          samples[p][k] = evaluateSample(set_, domains[p], corner(domains[p], k));
         }
       }
     });
-    corners_.assign(patches.size(), {-1, -1, -1, -1});
-    for (size_t p = 0; p < patches.size(); ++p) {
-      for (int k = 0; k < cornerCount(patches[p]); ++k) {
+    corners_.assign(domains.size(), {-1, -1, -1, -1});
+    for (size_t p = 0; p < domains.size(); ++p) {
+      for (int k = 0; k < cornerCount(domains[p]); ++k) {
         int id = welder_.find(samples[p][k].position);
         if (id < 0) {
           id = addVertex(samples[p][k]);
@@ -451,17 +453,17 @@ class Tessellator {
   }
 
   // The edge from corner k to the next, cut where finer neighbours' corners lie on it.
-  void splitEdge(const Domain& patch, int from, int to, Vec2 a, Vec2 b, int depth,
+  void splitEdge(const Domain& domain, int from, int to, Vec2 a, Vec2 b, int depth,
                  std::vector<Piece>& out) {
     if (depth < kMaxSplitDepth) {
       const Vec2 mid = lerp(a, b, 0.5);
       Vec3 position, ds, dt;
-      const Vec2 st = patch.toPatch(mid);
-      set_.evaluate(set_.patches()[patch.patch], st.x, st.y, position, ds, dt);
+      const Vec2 st = domain.toPatch(mid);
+      set_.evaluate(set_.patches()[domain.patch], st.x, st.y, position, ds, dt);
       const int m = welder_.find(position);
       if (m >= 0 && m != from && m != to) {
-        splitEdge(patch, from, m, a, mid, depth + 1, out);
-        splitEdge(patch, m, to, mid, b, depth + 1, out);
+        splitEdge(domain, from, m, a, mid, depth + 1, out);
+        splitEdge(domain, m, to, mid, b, depth + 1, out);
         return;
       }
     }
@@ -473,11 +475,11 @@ class Tessellator {
   // the curve still bulges sideways). Computed once per piece, by the first patch that needs it:
   // the other side reuses the vertices, so both agree. A piece crossing the eye plane is as
   // fine as allowed.
-  int segmentsOf(const Domain& patch, const Piece& piece) {
+  int segmentsOf(const Domain& domain, const Piece& piece) {
     const Vec3 a = camera_.project(positions_[piece.from]);
     const Vec3 b = camera_.project(positions_[piece.to]);
     const Vec3 m =
-        camera_.project(evaluateSample(set_, patch, lerp(piece.a, piece.b, 0.5)).position);
+        camera_.project(evaluateSample(set_, domain, lerp(piece.a, piece.b, 0.5)).position);
     double wanted =
         std::ceil((std::hypot(a.x - m.x, a.y - m.y) + std::hypot(m.x - b.x, m.y - b.y)) /
                   options_.dicingRate);
@@ -494,17 +496,17 @@ class Tessellator {
 
   // The vertices strictly inside a piece, from `from` towards `to`; made by the first patch
   // that needs them.
-  std::vector<int> pieceVertices(const Domain& patch, const Piece& piece) {
+  std::vector<int> pieceVertices(const Domain& domain, const Piece& piece) {
     const bool forward = piece.from < piece.to;
     const std::pair<int, int> key = std::minmax(piece.from, piece.to);
     auto it = edgeVertices_.find(key);
     if (it == edgeVertices_.end()) {
-      const int segments = segmentsOf(patch, piece);
+      const int segments = segmentsOf(domain, piece);
       std::vector<int> ids;
       for (int k = 1; k < segments; ++k) {
         const double t = static_cast<double>(k) / segments;
         const Vec2 st = forward ? lerp(piece.a, piece.b, t) : lerp(piece.b, piece.a, t);
-        ids.push_back(addVertex(evaluateSample(set_, patch, st)));
+        ids.push_back(addVertex(evaluateSample(set_, domain, st)));
       }
       it = edgeVertices_.emplace(key, std::move(ids)).first;
     }
@@ -514,20 +516,20 @@ class Tessellator {
   }
 
   Ring ringOf(size_t p) {
-    const Domain& patch = domains_[p];
-    const int n = cornerCount(patch);
+    const Domain& domain = domains_[p];
+    const int n = cornerCount(domain);
     Ring ring;
     ring.ids.resize(n);
     ring.at.resize(n);
     for (int k = 0; k < n; ++k) {
-      const Vec2 a = corner(patch, k), b = corner(patch, (k + 1) % n);
+      const Vec2 a = corner(domain, k), b = corner(domain, (k + 1) % n);
       std::vector<Piece> pieces;
-      splitEdge(patch, corners_[p][k], corners_[p][(k + 1) % n], a, b, 0, pieces);
+      splitEdge(domain, corners_[p][k], corners_[p][(k + 1) % n], a, b, 0, pieces);
       if (pieces.size() > 1) ++stats_.transitionEdges;
       for (const Piece& piece : pieces) {
         ring.ids[k].push_back(piece.from);
         ring.at[k].push_back(piece.a);
-        const std::vector<int> inside = pieceVertices(patch, piece);
+        const std::vector<int> inside = pieceVertices(domain, piece);
         for (size_t i = 0; i < inside.size(); ++i) {
           ring.ids[k].push_back(inside[i]);
           ring.at[k].push_back(lerp(piece.a, piece.b, (i + 1.0) / (inside.size() + 1.0)));
