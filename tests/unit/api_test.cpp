@@ -1082,6 +1082,9 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_EQ(file.limits.maxImageSide, builtIn.limits.maxImageSide);
   EXPECT_EQ(file.limits.maxSupersample, builtIn.limits.maxSupersample);
   EXPECT_EQ(file.limits.maxLevel, builtIn.limits.maxLevel);
+  EXPECT_EQ(file.limits.maxIsolation, builtIn.limits.maxIsolation);
+  EXPECT_EQ(file.limits.maxFrames, builtIn.limits.maxFrames);
+  EXPECT_EQ(file.limits.maxFramePixels, builtIn.limits.maxFramePixels);
   EXPECT_EQ(file.limits.minDicingRate, builtIn.limits.minDicingRate);
   EXPECT_EQ(file.limits.maxTriangles, builtIn.limits.maxTriangles);
   EXPECT_EQ(file.limits.mesh.maxValence, builtIn.limits.mesh.maxValence);
