@@ -20,6 +20,11 @@ void numberField(Writer& w, const char* key, double value) {
   writeNumber(w, value);
 }
 
+void countField(Writer& w, const char* key, size_t value) {
+  w.Key(key);
+  w.Uint64(value);
+}
+
 // The order images appear in the answer.
 std::vector<const char*> requestedPasses(const Outputs& outputs) {
   std::vector<const char*> names;
@@ -128,10 +133,7 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
   w.StartObject();
   w.Key("presubdivided");
   w.Bool(presubdivided);
-  auto count = [&](const char* key, size_t value) {
-    w.Key(key);
-    w.Uint64(value);
-  };
+  auto count = [&](const char* key, size_t value) { countField(w, key, value); };
   count("presubdivisionLevels", static_cast<size_t>(s.presubdivisionLevels));
   count("edgesTested", s.search.edgesTested);
   count("edgesWithSignChange", s.search.edgesWithSignChange);
@@ -156,10 +158,7 @@ void writeImplicitStats(Writer& w, const render::pipeline::Stats::Implicit& s) {
   const render::implicit::PolygonizerStats& p = s.polygonizer;
   w.Key("implicit");
   w.StartObject();
-  auto count = [&](const char* key, size_t value) {
-    w.Key(key);
-    w.Uint64(value);
-  };
+  auto count = [&](const char* key, size_t value) { countField(w, key, value); };
   count("primitives", s.primitives);
   w.Key("polygonizer");
   w.String(render::implicit::polygonizerName(s.method));
@@ -186,10 +185,7 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
   namespace patches = render::patches;
   w.Key("patchTable");
   w.StartObject();
-  auto count = [&](const char* key, size_t value) {
-    w.Key(key);
-    w.Uint64(value);
-  };
+  auto count = [&](const char* key, size_t value) { countField(w, key, value); };
   w.Key("isolation");
   w.Int(s.table.isolation);
   count("patches", s.table.patches);
