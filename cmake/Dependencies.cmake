@@ -13,6 +13,11 @@ find_library(OSD_CPU_LIBRARY osdCPU REQUIRED)
 add_library(opensubdiv INTERFACE)
 target_include_directories(opensubdiv INTERFACE ${OSD_INCLUDE_DIR})
 target_link_libraries(opensubdiv INTERFACE ${OSD_CPU_LIBRARY})
+# libosdGPU for the GLSL source of Osd's patch basis (the patches' tessellation shaders); it
+# links no GL library itself.
+find_library(OSD_GPU_LIBRARY osdGPU REQUIRED)
+add_library(opensubdiv_gpu INTERFACE)
+target_link_libraries(opensubdiv_gpu INTERFACE opensubdiv ${OSD_GPU_LIBRARY})
 
 # OpenImageIO: its exported target names /usr/include/opencv4, which does not exist unless
 # OpenCV is installed, and CMake refuses to generate with a missing include directory.

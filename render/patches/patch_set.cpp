@@ -116,6 +116,7 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
     for (int i = 0; i < table_->GetNumPatches(a); ++i) {
       Patch patch;
       patch.param = table_->GetPatchParam(a, i);
+      patch.type = descriptor.GetType();
       patch.handle.arrayIndex = a;
       patch.handle.patchIndex = static_cast<int>(patches_.size());
       patch.handle.vertIndex = i * descriptor.GetNumControlVertices();
@@ -194,6 +195,10 @@ void PatchSet::evaluate(const Patch& patch, double s, double t, Vec3& position, 
     ds += p * wDs[i];
     dt += p * wDt[i];
   }
+}
+
+Far::ConstIndexArray PatchSet::pointIndices(const Patch& patch) const {
+  return table_->GetPatchVertices(patch.handle);
 }
 
 std::vector<Vec3> PatchSet::controlPoints(const Patch& patch) const {

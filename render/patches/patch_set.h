@@ -38,6 +38,8 @@ inline constexpr int kMaxIsolation = 8;
 
 struct Patch {
   OpenSubdiv::Far::PatchTable::PatchHandle handle;
+  // REGULAR (16 points), GREGORY_BASIS (20), LOOP (12) or GREGORY_TRIANGLE (18).
+  OpenSubdiv::Far::PatchDescriptor::Type type = OpenSubdiv::Far::PatchDescriptor::REGULAR;
   OpenSubdiv::Far::PatchParam param;
   int baseFace = 0;
   int subFace = -1;  // the Ptex sub-face of a Catmull-Clark n-gon, -1 for quads and triangles
@@ -91,6 +93,10 @@ class PatchSet {
   Vec2 toFaceUV(const Patch& patch, double s, double t) const;
   // The patch's control points (any type).
   std::vector<Vec3> controlPoints(const Patch& patch) const;
+  // Where they are in points().
+  OpenSubdiv::Far::ConstIndexArray pointIndices(const Patch& patch) const;
+  // Control, refined and end-cap points, as the patch table indexes them (for the GPU).
+  const std::vector<Vec3>& points() const { return points_; }
   // A regular patch's 4 x 4 B-spline points, row by row (s runs along a row).
   std::array<Vec3, 16> bsplinePoints(const Patch& patch) const;
 

@@ -13,6 +13,25 @@
 
 namespace limn::render::patches {
 
+PatchDomain PatchDomain::child(int k) const {
+  const Vec2 half{0.5, 0.5};
+  PatchDomain c = *this;
+  c.axisA = {axisA.x * 0.5, axisA.y * 0.5};
+  c.axisB = {axisB.x * 0.5, axisB.y * 0.5};
+  static constexpr std::array<Vec2, 4> kQuadOffsets = {Vec2{0, 0}, Vec2{0.5, 0}, Vec2{0, 0.5},
+                                                       Vec2{0.5, 0.5}};
+  static constexpr std::array<Vec2, 3> kTriangleOffsets = {Vec2{0, 0}, Vec2{0.5, 0},
+                                                           Vec2{0, 0.5}};
+  if (triangle && k == 3) {  // corners (1/2, 1/2), (0, 1/2), (1/2, 0)
+    c.origin = toPatch(half);
+    c.axisA = {-c.axisA.x, -c.axisA.y};
+    c.axisB = {-c.axisB.x, -c.axisB.y};
+    return c;
+  }
+  c.origin = toPatch(triangle ? kTriangleOffsets[k] : kQuadOffsets[k]);
+  return c;
+}
+
 namespace {
 
 constexpr int kPatchesBetweenChecks = 256;
@@ -73,38 +92,6 @@ Vec2 lerp(Vec2 a, Vec2 b, double t) { return {a.x + (b.x - a.x) * t, a.y + (b.y 
 constexpr std::array<Vec2, 4> kQuadCorners = {Vec2{0, 0}, Vec2{1, 0}, Vec2{1, 1}, Vec2{0, 1}};
 constexpr std::array<Vec2, 3> kTriangleCorners = {Vec2{0, 0}, Vec2{1, 0}, Vec2{0, 1}};
 
-// A part of one patch tessellated as a unit: the patch's local coordinates are
-// origin + a * axisA + b * axisB for the domain's own (a, b) in the unit square or triangle.
-struct Domain {
-  int patch = 0;  // index into PatchSet::patches()
-  bool triangle = false;
-  Vec2 origin{0, 0}, axisA{1, 0}, axisB{0, 1};
-
-  Vec2 toPatch(Vec2 ab) const {
-    return {origin.x + ab.x * axisA.x + ab.y * axisB.x, origin.y + ab.x * axisA.y + ab.y * axisB.y};
-  }
-  // One of the four children of a split: quadrants, or for triangles the three corner
-  // triangles and the inverted middle one (same orientation).
-  Domain child(int k) const {
-    const Vec2 half{0.5, 0.5};
-    Domain c = *this;
-    c.axisA = {axisA.x * 0.5, axisA.y * 0.5};
-    c.axisB = {axisB.x * 0.5, axisB.y * 0.5};
-    static constexpr std::array<Vec2, 4> kQuadOffsets = {Vec2{0, 0}, Vec2{0.5, 0}, Vec2{0, 0.5},
-                                                         Vec2{0.5, 0.5}};
-    static constexpr std::array<Vec2, 3> kTriangleOffsets = {Vec2{0, 0}, Vec2{0.5, 0},
-                                                             Vec2{0, 0.5}};
-    if (triangle && k == 3) {  // corners (1/2, 1/2), (0, 1/2), (1/2, 0)
-      c.origin = toPatch(half);
-      c.axisA = {-c.axisA.x, -c.axisA.y};
-      c.axisB = {-c.axisB.x, -c.axisB.y};
-      return c;
-    }
-    c.origin = toPatch(triangle ? kTriangleOffsets[k] : kQuadOffsets[k]);
-    return c;
-  }
-};
-
 // Lines across a patch, as three points each: its edges and middle lines (for triangles, the
 // lines joining edge midpoints, counted twice as they are half as long).
 using Line = std::array<Vec2, 3>;
@@ -122,8 +109,7 @@ constexpr std::array<Line, 6> kTriangleLines = {
     Line{Vec2{0.5, 0}, Vec2{0.5, 0.25}, Vec2{0.5, 0.5}},
     Line{Vec2{0, 0.5}, Vec2{0.25, 0.5}, Vec2{0.5, 0.5}}};
 
-int cornerCount(const Domain& domain) { return domain.triangle ? 3 : 4; }
-Vec2 corner(const Domain& domain, int k) {
+Vec2 corner(const PatchDomain& domain, int k) {
   return domain.triangle ? kTriangleCorners[k] : kQuadCorners[k];
 }
 
@@ -133,7 +119,7 @@ struct Sample {
 
 // Position and unit normal at the domain's (a, b); where the derivatives vanish (some end-cap
 // corners), the normal a little way towards the domain's centre.
-Sample evaluateSample(const PatchSet& set, const Domain& domain, Vec2 ab) {
+Sample evaluateSample(const PatchSet& set, const PatchDomain& domain, Vec2 ab) {
   const Patch& patch = set.patches()[domain.patch];
   Sample out;
   Vec3 ds, dt;
@@ -156,6 +142,7 @@ Sample evaluateSample(const PatchSet& set, const Domain& domain, Vec2 ab) {
 struct Piece {
   int from, to;
   Vec2 a, b;
+  std::pair<int, int> key() const { return std::minmax(from, to); }
 };
 
 // What the inside of one patch becomes. Triangle corners are vertex ids when >= 0, and
@@ -291,12 +278,14 @@ void tessellateTriangleInside(const Ring& ring, int maxFactor, PatchInside& out)
   zipRing(ring, sides, interiorId, at, out);
 }
 
-// Triangles the inside of a patch will make (checked against the budget before evaluating).
-size_t insideTriangles(const Domain& domain, const Ring& ring, int maxFactor) {
+// Triangles a domain will make from its sides' segments (checked against the budget before
+// evaluating anything inside).
+size_t insideTriangles(const PatchDomain& domain, const std::array<int, 4>& sideSegments,
+                       int maxFactor) {
   int most = 1, sum = 0;
-  for (size_t k = 0; k < ring.ids.size(); ++k) {
-    most = std::max(most, ring.segments(static_cast<int>(k)));
-    sum += ring.segments(static_cast<int>(k));
+  for (int k = 0; k < domain.corners(); ++k) {
+    most = std::max(most, sideSegments[k]);
+    sum += sideSegments[k];
   }
   if (most == 1) return domain.triangle ? 1 : 2;
   const size_t n = std::min(most, maxFactor);
@@ -318,19 +307,46 @@ class Tessellator {
         cancel_(cancel),
         welder_(positions_, kWeldTolerance * std::max(set.controlBounds().diagonal(), 1e-300)) {}
 
-  PatchMesh run() {
+  // The domains, their welded corners and every side's pieces with their segments.
+  void plan() {
     chooseCulled();
     makeDomains();
-    const std::vector<Domain>& domains = domains_;
     weldCorners();
+    findPieces();
+    countSegments();
+    if (triangles_ > options_.maxTriangles) throw OverBudget{triangles_};
+  }
+
+  TessellationPlan exportPlan() {
+    TessellationPlan out;
+    out.domains = domains_;
+    out.sides.resize(domains_.size());
+    for (size_t p = 0; p < domains_.size(); ++p) {
+      for (int k = 0; k < domains_[p].corners(); ++k) {
+        const Vec2 from = corner(domains_[p], k), to = corner(domains_[p], (k + 1) % domains_[p].corners());
+        const Vec2 side{to.x - from.x, to.y - from.y};
+        const double length2 = side.x * side.x + side.y * side.y;
+        for (const Piece& piece : pieces_[p][k]) {
+          const double end = ((piece.b.x - from.x) * side.x + (piece.b.y - from.y) * side.y) / length2;
+          out.sides[p][k].push_back({end, segments_.at(piece.key())});
+        }
+        out.sides[p][k].back().end = 1;  // exactly
+      }
+    }
+    out.triangles = triangles_;
+    out.stats = finalStats();
+    return out;
+  }
+
+  // plan(), then every vertex and triangle.
+  PatchMesh run() {
+    plan();
+    const std::vector<PatchDomain>& domains = domains_;
     std::vector<Ring> rings(domains.size());
-    size_t triangles = 0;
     for (size_t p = 0; p < domains.size(); ++p) {
       if (p % kPatchesBetweenChecks == 0) cancel_.check();
       rings[p] = ringOf(p);
-      triangles += insideTriangles(domains[p], rings[p], options_.maxEdgeFactor);
     }
-    if (triangles > options_.maxTriangles) throw OverBudget{triangles};
     std::vector<PatchInside> insides(domains.size());
     parallelFor(domains.size(), 64, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
@@ -358,18 +374,18 @@ class Tessellator {
   }
 
   void weldCorners() {
-    const std::vector<Domain>& domains = domains_;
+    const std::vector<PatchDomain>& domains = domains_;
     std::vector<std::array<Sample, 4>> samples(domains.size());
     parallelFor(domains.size(), 256, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
-        for (int k = 0; k < cornerCount(domains[p]); ++k) {
+        for (int k = 0; k < domains[p].corners(); ++k) {
           samples[p][k] = evaluateSample(set_, domains[p], corner(domains[p], k));
         }
       }
     });
     corners_.assign(domains.size(), {-1, -1, -1, -1});
     for (size_t p = 0; p < domains.size(); ++p) {
-      for (int k = 0; k < cornerCount(domains[p]); ++k) {
+      for (int k = 0; k < domains[p].corners(); ++k) {
         int id = welder_.find(samples[p][k].position);
         if (id < 0) {
           id = addVertex(samples[p][k]);
@@ -408,7 +424,7 @@ class Tessellator {
     parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
         if (patchCulled_[p]) continue;
-        const Domain whole{static_cast<int>(p), patches[p].triangle};
+        const PatchDomain whole{static_cast<int>(p), patches[p].triangle};
         double longest = 0;
         for (const auto& line : whole.triangle ? kTriangleLines : kQuadLines) {
           std::array<Vec3, 3> pixel;
@@ -429,10 +445,10 @@ class Tessellator {
     for (size_t p = 0; p < patches.size(); ++p) {
       if (patchCulled_[p]) continue;
       if (splits[p] > 0) ++stats_.patchesSplit;
-      std::vector<Domain> level{Domain{static_cast<int>(p), patches[p].triangle}};
+      std::vector<PatchDomain> level{PatchDomain{static_cast<int>(p), patches[p].triangle}};
       for (int k = 0; k < splits[p]; ++k) {
-        std::vector<Domain> finer;
-        for (const Domain& d : level) {
+        std::vector<PatchDomain> finer;
+        for (const PatchDomain& d : level) {
           for (int c = 0; c < 4; ++c) finer.push_back(d.child(c));
         }
         level = std::move(finer);
@@ -453,7 +469,7 @@ class Tessellator {
   }
 
   // The edge from corner k to the next, cut where finer neighbours' corners lie on it.
-  void splitEdge(const Domain& domain, int from, int to, Vec2 a, Vec2 b, int depth,
+  void splitEdge(const PatchDomain& domain, int from, int to, Vec2 a, Vec2 b, int depth,
                  std::vector<Piece>& out) {
     if (depth < kMaxSplitDepth) {
       const Vec2 mid = lerp(a, b, 0.5);
@@ -472,10 +488,9 @@ class Tessellator {
 
   // Segments of one piece: the projected length of its end-midpoint-end polyline over the
   // dicing rate (the midpoint matters along the outline, where the chord is foreshortened but
-  // the curve still bulges sideways). Computed once per piece, by the first patch that needs it:
-  // the other side reuses the vertices, so both agree. A piece crossing the eye plane is as
+  // the curve still bulges sideways). A piece crossing the eye plane is as
   // fine as allowed.
-  int segmentsOf(const Domain& domain, const Piece& piece) {
+  int segmentsOf(const PatchDomain& domain, const Piece& piece) {
     const Vec3 a = camera_.project(positions_[piece.from]);
     const Vec3 b = camera_.project(positions_[piece.to]);
     const Vec3 m =
@@ -494,21 +509,68 @@ class Tessellator {
     return static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options_.maxEdgeFactor)));
   }
 
-  // The vertices strictly inside a piece, from `from` towards `to`; made by the first patch
+  // Every domain side cut where finer neighbours' corners lie on it.
+  void findPieces() {
+    pieces_.resize(domains_.size());
+    for (size_t p = 0; p < domains_.size(); ++p) {
+      if (p % kPatchesBetweenChecks == 0) cancel_.check();
+      const PatchDomain& domain = domains_[p];
+      const int n = domain.corners();
+      for (int k = 0; k < n; ++k) {
+        splitEdge(domain, corners_[p][k], corners_[p][(k + 1) % n], corner(domain, k),
+                  corner(domain, (k + 1) % n), 0, pieces_[p][k]);
+        if (pieces_[p][k].size() > 1) ++stats_.transitionEdges;
+      }
+    }
+  }
+
+  // Segments per piece, computed once per piece by the first domain that has it, so both sides
+  // agree. A side cut into P pieces keeps each to maxEdgeFactor / P segments (the cap is the
+  // smaller of its two sides'), so no side needs more than maxEdgeFactor in all: the most a
+  // hardware tessellator takes per edge.
+  void countSegments() {
+    std::map<std::pair<int, int>, int> cap;
+    for (const auto& sides : pieces_) {
+      for (const std::vector<Piece>& side : sides) {
+        const int share = std::max(1, options_.maxEdgeFactor / std::max<int>(1, side.size()));
+        for (const Piece& piece : side) {
+          auto [it, added] = cap.emplace(piece.key(), share);
+          if (!added) it->second = std::min(it->second, share);
+        }
+      }
+    }
+    triangles_ = 0;
+    for (size_t p = 0; p < domains_.size(); ++p) {
+      if (p % kPatchesBetweenChecks == 0) cancel_.check();
+      std::array<int, 4> sideSegments{0, 0, 0, 0};
+      for (int k = 0; k < domains_[p].corners(); ++k) {
+        for (const Piece& piece : pieces_[p][k]) {
+          auto it = segments_.find(piece.key());
+          if (it == segments_.end()) {
+            const int segments = std::min(segmentsOf(domains_[p], piece), cap.at(piece.key()));
+            it = segments_.emplace(piece.key(), segments).first;
+          }
+          sideSegments[k] += it->second;
+        }
+      }
+      triangles_ += insideTriangles(domains_[p], sideSegments, options_.maxEdgeFactor);
+    }
+  }
+
+  // The vertices strictly inside a piece, from `from` towards `to`; made by the first domain
   // that needs them.
-  std::vector<int> pieceVertices(const Domain& domain, const Piece& piece) {
+  std::vector<int> pieceVertices(const PatchDomain& domain, const Piece& piece) {
     const bool forward = piece.from < piece.to;
-    const std::pair<int, int> key = std::minmax(piece.from, piece.to);
-    auto it = edgeVertices_.find(key);
+    auto it = edgeVertices_.find(piece.key());
     if (it == edgeVertices_.end()) {
-      const int segments = segmentsOf(domain, piece);
+      const int segments = segments_.at(piece.key());
       std::vector<int> ids;
       for (int k = 1; k < segments; ++k) {
         const double t = static_cast<double>(k) / segments;
         const Vec2 st = forward ? lerp(piece.a, piece.b, t) : lerp(piece.b, piece.a, t);
         ids.push_back(addVertex(evaluateSample(set_, domain, st)));
       }
-      it = edgeVertices_.emplace(key, std::move(ids)).first;
+      it = edgeVertices_.emplace(piece.key(), std::move(ids)).first;
     }
     std::vector<int> out = it->second;
     if (!forward) std::reverse(out.begin(), out.end());
@@ -516,17 +578,13 @@ class Tessellator {
   }
 
   Ring ringOf(size_t p) {
-    const Domain& domain = domains_[p];
-    const int n = cornerCount(domain);
+    const PatchDomain& domain = domains_[p];
+    const int n = domain.corners();
     Ring ring;
     ring.ids.resize(n);
     ring.at.resize(n);
     for (int k = 0; k < n; ++k) {
-      const Vec2 a = corner(domain, k), b = corner(domain, (k + 1) % n);
-      std::vector<Piece> pieces;
-      splitEdge(domain, corners_[p][k], corners_[p][(k + 1) % n], a, b, 0, pieces);
-      if (pieces.size() > 1) ++stats_.transitionEdges;
-      for (const Piece& piece : pieces) {
+      for (const Piece& piece : pieces_[p][k]) {
         ring.ids[k].push_back(piece.from);
         ring.at[k].push_back(piece.a);
         const std::vector<int> inside = pieceVertices(domain, piece);
@@ -536,17 +594,21 @@ class Tessellator {
         }
       }
       ring.ids[k].push_back(corners_[p][(k + 1) % n]);
-      ring.at[k].push_back(b);
+      ring.at[k].push_back(corner(domain, (k + 1) % n));
     }
     return ring;
+  }
+
+  TessellationStats finalStats() {
+    stats_.patchesDrawn = std::count(patchCulled_.begin(), patchCulled_.end(), uint8_t{0});
+    stats_.domains = domains_.size();
+    return stats_;
   }
 
   PatchMesh assemble(std::vector<PatchInside>& insides) {
     const std::vector<Patch>& patches = set_.patches();
     PatchMesh out;
     tessellate::TriangleMesh& mesh = out.mesh;
-    stats_.patchesDrawn = std::count(patchCulled_.begin(), patchCulled_.end(), uint8_t{0});
-    stats_.domains = domains_.size();
     for (size_t d = 0; d < domains_.size(); ++d) {
       const int p = domains_[d].patch;
       PatchInside& in = insides[d];
@@ -570,7 +632,7 @@ class Tessellator {
       mesh.positions.emplace_back(positions_[i]);
       mesh.normals.emplace_back(normals_[i]);
     }
-    out.stats = stats_;
+    out.stats = finalStats();
     return out;
   }
 
@@ -581,9 +643,12 @@ class Tessellator {
   std::vector<Vec3> positions_, normals_;
   Welder welder_;
   std::vector<uint8_t> patchCulled_;
-  std::vector<Domain> domains_;              // the drawn patches, whole or cut
+  std::vector<PatchDomain> domains_;              // the drawn patches, whole or cut
   std::vector<std::array<int, 4>> corners_;  // welded corner vertices per domain
+  std::vector<std::array<std::vector<Piece>, 4>> pieces_;  // per domain and side
+  std::map<std::pair<int, int>, int> segments_;           // per piece, by its welded ends
   std::map<std::pair<int, int>, std::vector<int>> edgeVertices_;
+  size_t triangles_ = 0;
   TessellationStats stats_;
 };
 
@@ -655,12 +720,18 @@ bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& 
   return true;
 }
 
-PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
-                            const TessellationOptions& options, const CancelToken& cancel) {
+namespace {
+
+// `make(tessellator)` for a Tessellator with `options`, retried with a coarser dicing rate while
+// the factors exceed maxTriangles (when options.fitToBudget); the rate used goes into the stats.
+template <typename Make>
+auto withinBudget(const PatchSet& patches, const Camera& camera,
+                  const TessellationOptions& options, const CancelToken& cancel, Make make) {
   TessellationOptions tried = options;
   for (int attempt = 0;; ++attempt) {
     try {
-      PatchMesh out = Tessellator(patches, camera, tried, cancel).run();
+      Tessellator tessellator(patches, camera, tried, cancel);
+      auto out = make(tessellator);
       out.stats.dicingRate = tried.dicingRate;
       return out;
     } catch (const OverBudget& over) {
@@ -675,6 +746,23 @@ PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
                                            static_cast<double>(options.maxTriangles));
     }
   }
+}
+
+}  // namespace
+
+PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
+                            const TessellationOptions& options, const CancelToken& cancel) {
+  return withinBudget(patches, camera, options, cancel,
+                      [](Tessellator& tessellator) { return tessellator.run(); });
+}
+
+TessellationPlan planPatchTessellation(const PatchSet& patches, const Camera& camera,
+                                       const TessellationOptions& options,
+                                       const CancelToken& cancel) {
+  return withinBudget(patches, camera, options, cancel, [](Tessellator& tessellator) {
+    tessellator.plan();
+    return tessellator.exportPlan();
+  });
 }
 
 }  // namespace limn::render::patches

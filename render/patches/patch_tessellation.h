@@ -12,6 +12,7 @@
 // allow).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,39 @@ struct TessellationStats {
   double dicingRate = 0;        // the rate used (coarser than asked when fitted to the budget)
 };
 
+// A part of one patch tessellated as a unit: patch-local (s, t) = origin + a * axisA + b * axisB
+// for the domain's own (a, b) in the unit square or triangle.
+struct PatchDomain {
+  int patch = 0;  // index into PatchSet::patches()
+  bool triangle = false;
+  Vec2 origin{0, 0}, axisA{1, 0}, axisB{0, 1};
+
+  Vec2 toPatch(Vec2 ab) const {
+    return {origin.x + ab.x * axisA.x + ab.y * axisB.x, origin.y + ab.x * axisA.y + ab.y * axisB.y};
+  }
+  // One of the four children of a split: quadrants, or for triangles the three corner
+  // triangles and the inverted middle one (same orientation).
+  PatchDomain child(int k) const;
+  int corners() const { return triangle ? 3 : 4; }
+};
+
+// One piece of a domain's side (from corner k to corner k + 1): it ends at fraction `end` of
+// the side (the last piece at 1) and is cut into `segments` equal parameter steps.
+struct SidePiece {
+  double end = 1;
+  int segments = 1;
+};
+
+// The tessellation factors of every drawn domain, equal on both sides of every shared edge: a
+// side is one piece, or several where finer neighbours' corners lie on it (transition edges).
+// The pieces of one side add up to at most maxEdgeFactor segments.
+struct TessellationPlan {
+  std::vector<PatchDomain> domains;
+  std::vector<std::array<std::vector<SidePiece>, 4>> sides;  // per domain; 3 used by triangles
+  size_t triangles = 0;  // what tessellatePatches() makes of it
+  TessellationStats stats;
+};
+
 struct PatchMesh {
   tessellate::TriangleMesh mesh;       // with triangleFaces and cornerUVs (Bfr's, per base face)
   std::vector<int32_t> trianglePatch;  // index into PatchSet::patches(), per triangle
@@ -53,6 +87,12 @@ struct PatchMesh {
 // when the factors would make more than maxTriangles (unless fitToBudget), and Cancelled.
 PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
                             const TessellationOptions& options, const CancelToken& cancel);
+
+// The factors tessellatePatches() uses, without evaluating the inside of any patch (the GPU
+// path dices them in tessellation shaders). Same errors and budget fitting.
+TessellationPlan planPatchTessellation(const PatchSet& patches, const Camera& camera,
+                                       const TessellationOptions& options,
+                                       const CancelToken& cancel);
 
 // True when the patch's control points (which hold it) all lie outside the view.
 bool outsideTheView(const PatchSet& patches, const Patch& patch, const Camera& camera);

@@ -39,24 +39,44 @@ GLuint compile(GLenum stage, const std::string& source, const std::string& what)
   return shader;
 }
 
+const char* stageName(GLenum type) {
+  switch (type) {
+    case GL_VERTEX_SHADER:
+      return " vertex shader";
+    case GL_TESS_CONTROL_SHADER:
+      return " tessellation control shader";
+    case GL_TESS_EVALUATION_SHADER:
+      return " tessellation evaluation shader";
+    case GL_GEOMETRY_SHADER:
+      return " geometry shader";
+    case GL_FRAGMENT_SHADER:
+      return " fragment shader";
+    default:
+      return " shader";
+  }
+}
+
+std::vector<ShaderStage> classicStages(const std::string& vertexSource,
+                                       const std::string& fragmentSource,
+                                       const std::string& geometrySource) {
+  std::vector<ShaderStage> stages = {{GL_VERTEX_SHADER, vertexSource},
+                                     {GL_FRAGMENT_SHADER, fragmentSource}};
+  if (!geometrySource.empty()) stages.push_back({GL_GEOMETRY_SHADER, geometrySource});
+  return stages;
+}
+
 }  // namespace
 
 ShaderProgram::ShaderProgram(const std::string& name, const std::string& vertexSource,
-                             const std::string& fragmentSource, const std::string& geometrySource) {
-  struct Stage {
-    GLenum type;
-    const std::string* source;
-    const char* what;
-  };
-  std::vector<Stage> stages = {{GL_VERTEX_SHADER, &vertexSource, " vertex shader"},
-                               {GL_FRAGMENT_SHADER, &fragmentSource, " fragment shader"}};
-  if (!geometrySource.empty()) {
-    stages.push_back({GL_GEOMETRY_SHADER, &geometrySource, " geometry shader"});
-  }
+                             const std::string& fragmentSource, const std::string& geometrySource)
+    : ShaderProgram(name, classicStages(vertexSource, fragmentSource, geometrySource)) {}
+
+ShaderProgram::ShaderProgram(const std::string& name, const std::vector<ShaderStage>& stages,
+                             const std::vector<std::string>& feedbackVaryings) {
   std::vector<GLuint> shaders;
   try {
-    for (const Stage& stage : stages) {
-      shaders.push_back(compile(stage.type, *stage.source, name + stage.what));
+    for (const ShaderStage& stage : stages) {
+      shaders.push_back(compile(stage.type, stage.source, name + stageName(stage.type)));
     }
   } catch (...) {
     for (GLuint shader : shaders) glDeleteShader(shader);
@@ -64,6 +84,12 @@ ShaderProgram::ShaderProgram(const std::string& name, const std::string& vertexS
   }
   program_ = glCreateProgram();
   for (GLuint shader : shaders) glAttachShader(program_, shader);
+  if (!feedbackVaryings.empty()) {
+    std::vector<const char*> names;
+    for (const std::string& v : feedbackVaryings) names.push_back(v.c_str());
+    glTransformFeedbackVaryings(program_, static_cast<GLsizei>(names.size()), names.data(),
+                                GL_INTERLEAVED_ATTRIBS);
+  }
   glLinkProgram(program_);
   // The program keeps what it needs; the shader objects can go now.
   for (GLuint shader : shaders) glDeleteShader(shader);

@@ -1,6 +1,7 @@
 // Feature-adaptive patches (render/patches): the patch table against the limit surface, patch
 // counts that grow with the features rather than 4x per level, crack-free tessellation across
-// isolation levels, and back-patch culling that only drops hidden patches.
+// isolation levels, back-patch culling that only drops hidden patches, and the GPU path (the
+// same plan diced by tessellation shaders on this machine's OpenGL: llvmpipe or a GPU).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,8 +9,10 @@
 #include <numbers>
 #include <tuple>
 
+#include "render/patches/gpu_tessellation.h"
 #include "render/patches/patch_set.h"
 #include "render/patches/patch_tessellation.h"
+#include "render/raster/rasterizer.h"
 #include "render/subdiv/limit_surface.h"
 #include "tests/support/random_views.h"
 #include "tests/unit/test_meshes.h"
@@ -235,6 +238,191 @@ TEST(PatchCulling, DropsOnlyPatchesOutsideTheViewOrFacingAwayEverywhere) {
       }
     }
   }
+}
+
+// The GPU path needs a GL context current on the thread: a Rasterizer's, made once.
+class GpuTessellation : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    rasterizer_ = new raster::Rasterizer();
+    tessellator_ = new GpuPatchTessellator();
+  }
+  static void TearDownTestSuite() {
+    delete tessellator_;
+    delete rasterizer_;
+  }
+  static raster::Rasterizer* rasterizer_;
+  static GpuPatchTessellator* tessellator_;
+};
+raster::Rasterizer* GpuTessellation::rasterizer_ = nullptr;
+GpuPatchTessellator* GpuTessellation::tessellator_ = nullptr;
+
+// The triangles' vertices welded within `tolerance` (the GPU path's sides evaluate shared
+// vertices in their own patches, in float): an id per corner.
+std::vector<int> weldedCorners(const tessellate::TriangleMesh& mesh, double tolerance) {
+  std::map<std::tuple<int64_t, int64_t, int64_t>, std::vector<int>> cells;
+  std::vector<Vec3> representatives;
+  std::vector<int> out;
+  for (uint32_t index : mesh.indices) {
+    const Vec3 p = mesh.positions[index].toDouble();
+    const int64_t x = std::llround(p.x / tolerance), y = std::llround(p.y / tolerance),
+                  z = std::llround(p.z / tolerance);
+    int found = -1;
+    for (int dx = -1; dx <= 1 && found < 0; ++dx) {
+      for (int dy = -1; dy <= 1 && found < 0; ++dy) {
+        for (int dz = -1; dz <= 1 && found < 0; ++dz) {
+          auto it = cells.find({x + dx, y + dy, z + dz});
+          if (it == cells.end()) continue;
+          for (int id : it->second) {
+            if (length(representatives[id] - p) <= tolerance) found = id;
+          }
+        }
+      }
+    }
+    if (found < 0) {
+      found = static_cast<int>(representatives.size());
+      representatives.push_back(p);
+      cells[{x, y, z}].push_back(found);
+    }
+    out.push_back(found);
+  }
+  return out;
+}
+
+// Welded by position, every edge of a closed surface's triangles is used exactly twice
+// (triangles collapsed by the welding, at degenerate patch corners, left out).
+void expectWatertightWhenWelded(const tessellate::TriangleMesh& mesh, double tolerance,
+                                const std::string& what) {
+  const std::vector<int> id = weldedCorners(mesh, tolerance);
+  std::map<std::pair<int, int>, int> uses;
+  for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+    const int a = id[3 * t], b = id[3 * t + 1], c = id[3 * t + 2];
+    if (a == b || b == c || c == a) continue;
+    ++uses[std::minmax(a, b)];
+    ++uses[std::minmax(b, c)];
+    ++uses[std::minmax(c, a)];
+  }
+  int bad = 0;
+  for (const auto& [edge, count] : uses) bad += count != 2;
+  EXPECT_EQ(bad, 0) << what;
+}
+
+// Every vertex on the limit surface at its (face, u, v), and with the limit normal (but at a
+// few corners: those of an open mesh's boundary, where the CPU path's normals differ too).
+void expectOnTheLimitSurface(const tessellate::TriangleMesh& mesh,
+                             const subdiv::LimitSurface& surface, const std::string& what) {
+  const double diag = surface.bounds().diagonal();
+  double worst = 0;
+  size_t normalsOff = 0;
+  for (size_t c = 0; c < mesh.indices.size(); ++c) {
+    const Vec2f uv = mesh.cornerUVs[c];
+    const subdiv::LimitSample exact = surface.evaluate(mesh.triangleFaces[c / 3], uv.x, uv.y);
+    const uint32_t v = mesh.indices[c];
+    worst = std::max(worst, length(mesh.positions[v].toDouble() - exact.position) / diag);
+    normalsOff += dot(mesh.normals[v].toDouble(), exact.normal) < 0.9;
+  }
+  EXPECT_LT(worst, 1e-5) << what;  // float evaluation
+  EXPECT_LE(normalsOff, mesh.indices.size() / 1000) << what;
+}
+
+TEST_F(GpuTessellation, DicesThePlanOnTheLimitSurfaceWithoutCracks) {
+  for (auto& [name, m] : closedMeshes()) {
+    subdiv::LimitSurface surface(m);
+    // At Bfr's isolation the patches are the limit surface; at 2 they are near it only.
+    for (int isolation : {2, subdiv::kApproxLevel}) {
+      PatchSet set(m, isolation, CancelToken());
+      for (double rate : {1.5, 4.0, 40.0}) {
+        TessellationOptions options;
+        options.dicingRate = rate;
+        options.cullHidden = false;
+        const Camera camera = viewOf(set, 1);
+        const std::string what =
+            name + ", isolation " + std::to_string(isolation) + ", rate " + std::to_string(rate);
+        const TessellationPlan plan = planPatchTessellation(set, camera, options, CancelToken());
+        const PatchMesh gpu = tessellator_->tessellate(set, plan, CancelToken());
+        const PatchMesh cpu = tessellatePatches(set, camera, options, CancelToken());
+        EXPECT_EQ(gpu.stats.domains, cpu.stats.domains) << what;
+        EXPECT_EQ(gpu.trianglePatch.size(), gpu.mesh.triangleCount()) << what;
+        // The hardware pattern differs from the CPU's grid, not by much.
+        EXPECT_GT(gpu.mesh.triangleCount(), cpu.mesh.triangleCount() / 2) << what;
+        EXPECT_LT(gpu.mesh.triangleCount(), cpu.mesh.triangleCount() * 2) << what;
+        if (isolation == subdiv::kApproxLevel) {
+          expectOnTheLimitSurface(gpu.mesh, surface, what);
+        }
+        expectWatertightWhenWelded(gpu.mesh, 1e-5 * set.controlBounds().diagonal(), what);
+      }
+    }
+  }
+}
+
+TEST_F(GpuTessellation, KeepsTheWindingAndCutDomainsAndBatches) {
+  for (auto& [name, m] : closedMeshes()) {
+    PatchSet set(m, 1, CancelToken());
+    TessellationOptions options;
+    options.dicingRate = 1.2;  // cuts patches into domains
+    options.cullHidden = false;
+    const TessellationPlan plan =
+        planPatchTessellation(set, viewOf(set, 0, 512), options, CancelToken());
+    ASSERT_GT(plan.stats.patchesSplit, 0u) << name;
+    GpuTessellationStats stats;
+    const PatchMesh gpu = tessellator_->tessellate(set, plan, CancelToken(), &stats);
+    expectWatertightWhenWelded(gpu.mesh, 1e-5 * set.controlBounds().diagonal(), name);
+    size_t agree = 0, counted = 0;
+    for (size_t t = 0; t < gpu.mesh.triangleCount(); ++t) {
+      Vec3 p[3], n{0, 0, 0};
+      for (int k = 0; k < 3; ++k) {
+        p[k] = gpu.mesh.positions[3 * t + k].toDouble();
+        n += gpu.mesh.normals[3 * t + k].toDouble();
+      }
+      const Vec3 face = cross(p[1] - p[0], p[2] - p[0]);
+      if (length(face) < 1e-12) continue;
+      ++counted;
+      agree += dot(face, n) > 0;
+    }
+    EXPECT_GT(agree, counted * 999 / 1000) << name;
+
+    // Small batches: more draws, the same triangles in the same order.
+    GpuPatchTessellator small(7);
+    GpuTessellationStats smallStats;
+    const PatchMesh batched = small.tessellate(set, plan, CancelToken(), &smallStats);
+    EXPECT_GT(smallStats.draws, stats.draws) << name;
+    ASSERT_EQ(batched.mesh.positions.size(), gpu.mesh.positions.size()) << name;
+    EXPECT_TRUE(std::equal(batched.mesh.positions.begin(), batched.mesh.positions.end(),
+                           gpu.mesh.positions.begin(),
+                           [](const Vec3f& a, const Vec3f& b) {
+                             return a.x == b.x && a.y == b.y && a.z == b.z;
+                           }))
+        << name;
+  }
+}
+
+TEST_F(GpuTessellation, EvaluatesBoundaryPatchesOfOpenMeshes) {
+  // A wavy quad grid and an icosahedron with two faces cut out (Loop, with a boundary).
+  ControlMesh openIcosahedron = limn::testing::icosahedron();
+  for (int k = 0; k < 2; ++k) {
+    openIcosahedron.faceVertexCounts.pop_back();
+    openIcosahedron.faceVertexIndices.resize(openIcosahedron.faceVertexIndices.size() - 3);
+  }
+  for (const ControlMesh& m : {limn::testing::grid(5), openIcosahedron}) {
+    subdiv::LimitSurface surface(m);
+    PatchSet set(m, subdiv::kApproxLevel, CancelToken());
+    TessellationOptions options;
+    options.dicingRate = 3;
+    const TessellationPlan plan = planPatchTessellation(set, viewOf(set, 2), options, CancelToken());
+    const PatchMesh gpu = tessellator_->tessellate(set, plan, CancelToken());
+    ASSERT_GT(gpu.mesh.triangleCount(), 0u);
+    expectOnTheLimitSurface(gpu.mesh, surface, "grid");
+  }
+}
+
+TEST_F(GpuTessellation, StopsWhenCancelled) {
+  const ControlMesh m = limn::testing::torus(12, 8, true);
+  PatchSet set(m, 3, CancelToken());
+  const TessellationPlan plan =
+      planPatchTessellation(set, viewOf(set, 0), TessellationOptions{}, CancelToken());
+  CancelToken cancelled;
+  cancelled.cancel();
+  EXPECT_THROW(tessellator_->tessellate(set, plan, cancelled), Cancelled);
 }
 
 }  // namespace
