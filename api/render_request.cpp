@@ -135,16 +135,9 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
     out.cullPatches = json::boolean(*v, "params.cullPatches");
   }
   if (const Value* v = json::find(params, "tessellator")) {
-    std::string_view tessellator = json::string(*v, "params.tessellator");
-    if (tessellator == "gpu") {
-      json::fail("params.tessellator",
-                 "params.tessellator \"gpu\" (tessellation shaders) is not implemented yet; "
-                 "\"cpu\" is");
-    }
-    if (tessellator != "cpu") {
-      json::fail("params.tessellator",
-                 "params.tessellator must be \"cpu\"; got " + json::quote(tessellator));
-    }
+    using render::pipeline::PatchTessellator;
+    out.tessellator = json::choice<PatchTessellator>(
+        *v, "params.tessellator", {{"cpu", PatchTessellator::Cpu}, {"gpu", PatchTessellator::Gpu}});
   }
   if (const Value* v = json::find(params, "referenceCrossCheck")) {
     out.referenceCrossCheck = json::boolean(*v, "params.referenceCrossCheck");

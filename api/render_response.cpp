@@ -212,6 +212,9 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
   numberField(w, "dicingRate", s.tessellation.dicingRate);
   numberField(w, "tableMs", s.tableMs);
   numberField(w, "tessellateMs", s.tessellateMs);
+  w.Key("tessellator");
+  w.String(s.tessellator == render::pipeline::PatchTessellator::Gpu ? "gpu" : "cpu");
+  count("gpuDraws", s.gpuDraws);
   w.EndObject();
 }
 

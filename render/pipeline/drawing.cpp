@@ -7,6 +7,7 @@
 #include "render/core/error.h"
 #include "render/normalmap/mapped_cage.h"
 #include "render/normalmap/normal_atlas.h"
+#include "render/patches/gpu_tessellation.h"
 #include "render/patches/patch_image.h"
 #include "render/pipeline/job_checks.h"
 #include "render/pipeline/measure.h"
@@ -90,9 +91,46 @@ std::string formatRate(double rate) {
 
 }  // namespace
 
+namespace {
+
+// The context's tessellation shaders, compiled on first use (in its rasterizer's GL context,
+// made current here).
+patches::GpuPatchTessellator& gpuTessellator(RenderContext* context) {
+  if (context == nullptr || context->rasterizer == nullptr) {
+    badParameter("params.tessellator",
+                 "params.tessellator \"gpu\" dices the patches in the renderer's OpenGL context; "
+                 "a mesh for download (/v1/tessellate) is made by \"cpu\"");
+  }
+  context->rasterizer->makeCurrent();
+  if (!context->gpuTessellator) {
+    context->gpuTessellator = std::make_shared<patches::GpuPatchTessellator>();
+  }
+  return *context->gpuTessellator;
+}
+
+patches::PatchMesh dicePatches(const patches::PatchSet& set, patches::TessellationOptions options,
+                               PatchTessellator tessellator, RenderContext* context,
+                               const Camera& camera, const CancelToken& cancel,
+                               Stats::Patches& stats) {
+  stats.tessellator = tessellator;
+  if (tessellator == PatchTessellator::Cpu) {
+    return patches::tessellatePatches(set, camera, options, cancel);
+  }
+  patches::GpuPatchTessellator& gpu = gpuTessellator(context);
+  options.maxEdgeFactor = std::min(options.maxEdgeFactor, gpu.maxTessLevel());
+  const patches::TessellationPlan plan =
+      patches::planPatchTessellation(set, camera, options, cancel);
+  patches::GpuTessellationStats gpuStats;
+  patches::PatchMesh out = gpu.tessellate(set, plan, cancel, &gpuStats);
+  stats.gpuDraws = gpuStats.draws;
+  return out;
+}
+
+}  // namespace
+
 void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
-                        const JobLimits& limits, const Camera& camera, const CancelToken& cancel,
-                        Approximated& out) {
+                        const JobLimits& limits, const Camera& camera, RenderContext* context,
+                        const CancelToken& cancel, Approximated& out) {
   Stopwatch clock;
   Stats::Patches stats{.table = set.stats(), .tessellation = {}, .tableMs = set.stats().buildMs};
   patches::TessellationOptions options;
@@ -102,7 +140,8 @@ void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice
   // At 1 px and 1024^2 a coarse Loop mesh would ask for 10M+ triangles (adaptive caps its
   // faces' edges at 128 segments instead): the rate is coarsened to fit, and said.
   options.fitToBudget = true;
-  patches::PatchMesh tessellation = patches::tessellatePatches(set, camera, options, cancel);
+  patches::PatchMesh tessellation = dicePatches(set, options, choice.params.tessellator, context,
+                                                camera, cancel, stats);
   if (tessellation.stats.dicingRate > options.dicingRate) {
     out.warnings.push_back("params.dicingRate raised from " + formatRate(options.dicingRate) +
                            " to " + formatRate(tessellation.stats.dicingRate) +
@@ -127,16 +166,17 @@ namespace {
 
 // The patches method: Far's feature-adaptive patch table, tessellated for the camera.
 void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
-                            const Camera& camera, const CancelToken& cancel, Approximated& out) {
+                            const Camera& camera, RenderContext* context,
+                            const CancelToken& cancel, Approximated& out) {
   const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel);
-  tessellatePatchSet(set, choice, limits, camera, cancel, out);
+  tessellatePatchSet(set, choice, limits, camera, context, cancel, out);
 }
 
 }  // namespace
 
 Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limits,
                                const subdiv::LimitSurface& surface, const Camera& camera,
-                               const CancelToken& cancel) {
+                               RenderContext* context, const CancelToken& cancel) {
   Stopwatch clock;
   Approximated out;
   if (choice.method == Method::Silhouette) {
@@ -153,7 +193,7 @@ Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limi
     }
     out.mesh = std::move(build.built.mesh);
   } else if (choice.method == Method::Patches) {
-    approximateWithPatches(choice, limits, camera, cancel, out);
+    approximateWithPatches(choice, limits, camera, context, cancel, out);
   } else {
     out.mesh = tessellateMethod(choice, limits, surface, camera, cancel);
   }
@@ -170,7 +210,8 @@ MethodDrawing drawMethod(const MethodChoice& choice, const JobLimits& limits,
                          const subdiv::LimitSurface& surface, const Camera& camera,
                          RenderContext& context, bool measured, int supersample,
                          const CancelToken& cancel) {
-  return rasterizeApproximation(approximateMethod(choice, limits, surface, camera, cancel), choice,
+  return rasterizeApproximation(approximateMethod(choice, limits, surface, camera, &context, cancel),
+                                choice,
                                 surface, camera, context, measured, supersample, cancel);
 }
 

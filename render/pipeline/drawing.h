@@ -54,15 +54,17 @@ struct Approximated {
 };
 
 // The method's approximation (checks of `choice` against `limits` are the caller's: checkMethod).
+// `context` (null for a mesh to download) serves the patches' GPU tessellator.
 Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limits,
                                const subdiv::LimitSurface& surface, const Camera& camera,
-                               const CancelToken& cancel);
+                               RenderContext* context, const CancelToken& cancel);
 
 // The patches method on a patch table already built (animation frames reuse one): its
-// tessellation for `camera`, stats and, with outputs.patches, the patch image's mesh.
+// tessellation for `camera` (by the CPU, or by `context`'s GPU tessellator), stats and, with
+// outputs.patches, the patch image's mesh.
 void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
-                        const JobLimits& limits, const Camera& camera, const CancelToken& cancel,
-                        Approximated& out);
+                        const JobLimits& limits, const Camera& camera, RenderContext* context,
+                        const CancelToken& cancel, Approximated& out);
 
 // An approximation and its raster passes.
 struct MethodDrawing {

@@ -5,6 +5,7 @@
 // about either.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,9 @@
 namespace limn::render::raster {
 class Rasterizer;
 }
+namespace limn::render::patches {
+class GpuPatchTessellator;
+}
 
 namespace limn::render::pipeline {
 
@@ -34,6 +38,8 @@ enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette, Patches };
 // masks or, for Catmull-Clark, in factored form.
 enum class Engine { OpenSubdiv, Masks, Factored };
 
+enum class PatchTessellator { Cpu, Gpu };
+
 struct MethodParams {
   int level = 3;                       // uniform
   Engine engine = Engine::OpenSubdiv;  // uniform
@@ -41,6 +47,9 @@ struct MethodParams {
   double dicingRate = 1.0;             // adaptive, patches: target edge length in pixels
   int isolation = patches::kDefaultIsolation;  // patches: Far's adaptive isolation level
   bool cullPatches = true;    // patches: leave out patches outside the view or facing away
+  // patches: who dices the patches, the CPU (welded, shared edge vertices) or the GPU's
+  // tessellation stages (the same factors; llvmpipe where there is no GPU).
+  PatchTessellator tessellator = PatchTessellator::Cpu;
   int metricSupersample = 4;  // S for the silhouette metrics
   // Also ray-cast Embree's own subdivision geometry and report its agreement with the reference
   // (Catmull-Clark only; costs about as much as the reference itself).
@@ -121,6 +130,8 @@ struct Stats {
     patches::PatchTableStats table;
     patches::TessellationStats tessellation;
     double tableMs = 0, tessellateMs = 0;
+    PatchTessellator tessellator = PatchTessellator::Cpu;
+    size_t gpuDraws = 0;  // the GPU path's draw calls
   };
   std::optional<Patches> patchTable;
   // Implicit jobs: what the polygoniser did and how closed its mesh is.
@@ -163,6 +174,8 @@ struct RenderContext {
   raster::Rasterizer* rasterizer = nullptr;
   // Shared by all workers; null: every reference builds its own scene.
   oracle::ReferenceSceneCache* referenceCache = nullptr;
+  // The patches' tessellation shaders, compiled in the rasterizer's context on first use.
+  std::shared_ptr<patches::GpuPatchTessellator> gpuTessellator;
 };
 
 // Runs the job. Throws InputError for what the request got wrong and Cancelled when `cancel`

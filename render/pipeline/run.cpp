@@ -82,7 +82,7 @@ Approximation approximate(const RenderJob& job, const JobLimits& limits,
   cancel.check();
   const Outputs none{.color = false};  // a mesh to hand out: no overlays
   Approximated made = approximateMethod({job.mesh, job.method, job.params, job.shading, none},
-                                        limits, surface, out.camera, cancel);
+                                        limits, surface, out.camera, nullptr, cancel);
   out.mesh = std::move(made.mesh);
   out.stats.triangles = made.stats.triangles;
   out.stats.vertices = made.stats.vertices;

@@ -79,7 +79,7 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
     frameMesh.points = job.frames[f];
     const MethodChoice choice{frameMesh, job.method, job.params, job.shading, outputs};
     Approximated approx;
-    tessellatePatchSet(set, choice, limits, result.camera, cancel, approx);
+    tessellatePatchSet(set, choice, limits, result.camera, &context, cancel, approx);
     if (job.outputs.cage)
       approx.overlays.push_back(tessellate::cageOverlay(frameMesh, pass::kCage));
     approx.stats.triangles = approx.mesh.triangleCount();

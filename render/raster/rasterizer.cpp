@@ -330,6 +330,8 @@ Rasterizer::~Rasterizer() = default;
 
 const DeviceInfo& Rasterizer::device() const { return impl_->device; }
 
+void Rasterizer::makeCurrent() { impl_->context.makeCurrent(); }
+
 ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& camera,
                             const PassSelection& passes, Shading shading,
                             const std::vector<LineOverlay>& overlays, const CancelToken& cancel) {

@@ -55,6 +55,9 @@ class Rasterizer {
   Rasterizer& operator=(const Rasterizer&) = delete;
 
   const DeviceInfo& device() const;
+  // Makes its context current on the calling thread, for GL work of other modules between
+  // renders (the patches' tessellation shaders); render() does it itself.
+  void makeCurrent();
 
   // Draws `mesh` for `camera` and returns the selected passes at the camera's size, plus the
   // supersampled coverage mask when passes.supersample > 0, plus one pass per overlay, named

@@ -729,11 +729,14 @@ TEST(RenderRequest, UnknownMethodAndOutputListTheValidNames) {
       << method.message;
   EXPECT_TRUE(contains(method.message, "\"magic\"")) << method.message;
 
-  ApiError gpu =
-      parseError(cubeRequest(R"(, "method": "patches", "params": {"tessellator": "gpu"})"));
-  expectError(gpu, 400, "invalid_request");
-  EXPECT_EQ(detailMember(gpu, "field"), "params.tessellator");
-  EXPECT_TRUE(contains(gpu.message, "not implemented yet")) << gpu.message;
+  api::RenderRequest gpu = api::parseRenderRequest(
+      cubeRequest(R"(, "method": "patches", "params": {"tessellator": "gpu"})"), {});
+  EXPECT_EQ(gpu.job.params.tessellator, render::pipeline::PatchTessellator::Gpu);
+  ApiError tessellator =
+      parseError(cubeRequest(R"(, "method": "patches", "params": {"tessellator": "tpu"})"));
+  expectError(tessellator, 400, "invalid_request");
+  EXPECT_EQ(detailMember(tessellator, "field"), "params.tessellator");
+  EXPECT_TRUE(contains(tessellator.message, R"("cpu", "gpu")")) << tessellator.message;
   ApiError patchImage =
       parseError(cubeRequest(R"(, "method": "adaptive", "outputs": ["patches"])"));
   expectError(patchImage, 400, "invalid_request");
