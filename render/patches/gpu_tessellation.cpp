@@ -218,8 +218,8 @@ void requireLimit(GLenum name, int needed, const char* what) {
   glGetIntegerv(name, &value);
   checkGl("querying the tessellation limits");
   if (value < needed) {
-    throw std::runtime_error(std::string("gpu tessellation needs ") + std::to_string(needed) +
-                             " " + what + "; this OpenGL has " + std::to_string(value));
+    throw std::runtime_error(std::string("gpu tessellation needs ") + std::to_string(needed) + " " +
+                             what + "; this OpenGL has " + std::to_string(value));
   }
 }
 
@@ -236,8 +236,9 @@ void fill(GLuint buffer, const std::vector<T>& data) {
 std::array<float, kLevelFloats> glLevels(bool triangle, const std::array<int, 4>& side) {
   if (triangle) {
     const int inner = std::max({side[0], side[1], side[2]});
-    return {static_cast<float>(side[1]), static_cast<float>(side[2]), static_cast<float>(side[0]),
-            1.0f, static_cast<float>(inner), 1.0f};
+    return {static_cast<float>(side[1]), static_cast<float>(side[2]),
+            static_cast<float>(side[0]), 1.0f,
+            static_cast<float>(inner),   1.0f};
   }
   return {static_cast<float>(side[3]),
           static_cast<float>(side[0]),
@@ -253,8 +254,8 @@ struct DomainBound {
   size_t triangles = 0, vertices = 0;
 };
 DomainBound domainBound(bool triangle, const std::array<float, kLevelFloats>& levels) {
-  const size_t outer = static_cast<size_t>(levels[0] + levels[1] + levels[2] +
-                                           (triangle ? 0.0f : levels[3]));
+  const size_t outer =
+      static_cast<size_t>(levels[0] + levels[1] + levels[2] + (triangle ? 0.0f : levels[3]));
   const size_t a = static_cast<size_t>(levels[4]) + 2;
   const size_t b = triangle ? a : static_cast<size_t>(levels[5]) + 2;
   return {2 * a * b + outer, a * b + outer};
@@ -307,14 +308,15 @@ struct GpuPatchTessellator::Impl {
     std::vector<float> points;
     points.reserve(set.points().size() * 3);
     for (const Vec3& p : set.points()) {
-      points.insert(points.end(), {static_cast<float>(p.x), static_cast<float>(p.y),
-                                   static_cast<float>(p.z)});
+      points.insert(points.end(),
+                    {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
     }
     std::vector<int32_t> info, indices;
     for (const Patch& patch : set.patches()) {
-      info.insert(info.end(), {static_cast<int32_t>(indices.size()), static_cast<int32_t>(patch.type),
-                               static_cast<int32_t>(patch.param.field0),
-                               static_cast<int32_t>(patch.param.field1)});
+      info.insert(
+          info.end(),
+          {static_cast<int32_t>(indices.size()), static_cast<int32_t>(patch.type),
+           static_cast<int32_t>(patch.param.field0), static_cast<int32_t>(patch.param.field1)});
       for (int index : set.pointIndices(patch)) indices.push_back(index);
     }
     std::vector<float> frames, pieces, levelData;
@@ -330,8 +332,8 @@ struct GpuPatchTessellator::Impl {
       std::array<int, 4> segments{1, 1, 1, 1};
       for (int k = 0; k < 4; ++k) {
         const std::vector<SidePiece>& side = plan.sides[d][k];
-        sides.insert(sides.end(), {static_cast<int32_t>(pieces.size() / 2),
-                                   static_cast<int32_t>(side.size())});
+        sides.insert(sides.end(),
+                     {static_cast<int32_t>(pieces.size() / 2), static_cast<int32_t>(side.size())});
         if (k >= domain.corners()) continue;
         int upTo = 0;
         for (const SidePiece& piece : side) {
@@ -354,20 +356,19 @@ struct GpuPatchTessellator::Impl {
     fill(buffers[kDomainSides], sides);
     fill(buffers[kPieces], pieces);
     fill(buffers[kLevels], levelData);
-    for (GLuint b = 0; b < kBindings; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]);
+    for (GLuint b = 0; b < kBindings; ++b)
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, buffers[b]);
     checkGl("uploading the patches for gpu tessellation");
   }
 
   // Domains [first, first + count) drawn in one call; their triangles' vertices appended.
-  void drawBatch(size_t first, size_t count, size_t bound,
-                 std::vector<CapturedVertex>& out) {
+  void drawBatch(size_t first, size_t count, size_t bound, std::vector<CapturedVertex>& out) {
     const size_t bytes = bound * 3 * sizeof(CapturedVertex);
     if (bytes > feedbackBytes) {
       glNamedBufferData(feedback, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
       feedbackBytes = bytes;
     }
-    glBindBufferRange(GL_TRANSFORM_FEEDBACK_BUFFER, 0, feedback, 0,
-                      static_cast<GLsizeiptr>(bytes));
+    glBindBufferRange(GL_TRANSFORM_FEEDBACK_BUFFER, 0, feedback, 0, static_cast<GLsizeiptr>(bytes));
     glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, writtenQuery);
     glBeginQuery(GL_PRIMITIVES_GENERATED, generatedQuery);
     glBeginTransformFeedback(GL_TRIANGLES);

@@ -52,8 +52,8 @@ class GpuPatchTessellator {
 
   // The plan's domains of `set` as triangles. `plan` must come from planPatchTessellation() on
   // the same set with maxEdgeFactor <= maxTessLevel(). Checks `cancel` between batches.
-  PatchMesh tessellate(const PatchSet& set, const TessellationPlan& plan,
-                       const CancelToken& cancel, GpuTessellationStats* stats = nullptr);
+  PatchMesh tessellate(const PatchSet& set, const TessellationPlan& plan, const CancelToken& cancel,
+                       GpuTessellationStats* stats = nullptr);
 
  private:
   struct Impl;

@@ -20,8 +20,7 @@ PatchDomain PatchDomain::child(int k) const {
   c.axisB = {axisB.x * 0.5, axisB.y * 0.5};
   static constexpr std::array<Vec2, 4> kQuadOffsets = {Vec2{0, 0}, Vec2{0.5, 0}, Vec2{0, 0.5},
                                                        Vec2{0.5, 0.5}};
-  static constexpr std::array<Vec2, 3> kTriangleOffsets = {Vec2{0, 0}, Vec2{0.5, 0},
-                                                           Vec2{0, 0.5}};
+  static constexpr std::array<Vec2, 3> kTriangleOffsets = {Vec2{0, 0}, Vec2{0.5, 0}, Vec2{0, 0.5}};
   if (triangle && k == 3) {  // corners (1/2, 1/2), (0, 1/2), (1/2, 0)
     c.origin = toPatch(half);
     c.axisA = {-c.axisA.x, -c.axisA.y};
@@ -323,11 +322,13 @@ class Tessellator {
     out.sides.resize(domains_.size());
     for (size_t p = 0; p < domains_.size(); ++p) {
       for (int k = 0; k < domains_[p].corners(); ++k) {
-        const Vec2 from = corner(domains_[p], k), to = corner(domains_[p], (k + 1) % domains_[p].corners());
+        const Vec2 from = corner(domains_[p], k),
+                   to = corner(domains_[p], (k + 1) % domains_[p].corners());
         const Vec2 side{to.x - from.x, to.y - from.y};
         const double length2 = side.x * side.x + side.y * side.y;
         for (const Piece& piece : pieces_[p][k]) {
-          const double end = ((piece.b.x - from.x) * side.x + (piece.b.y - from.y) * side.y) / length2;
+          const double end =
+              ((piece.b.x - from.x) * side.x + (piece.b.y - from.y) * side.y) / length2;
           out.sides[p][k].push_back({end, segments_.at(piece.key())});
         }
         out.sides[p][k].back().end = 1;  // exactly
@@ -643,10 +644,10 @@ class Tessellator {
   std::vector<Vec3> positions_, normals_;
   Welder welder_;
   std::vector<uint8_t> patchCulled_;
-  std::vector<PatchDomain> domains_;              // the drawn patches, whole or cut
-  std::vector<std::array<int, 4>> corners_;  // welded corner vertices per domain
+  std::vector<PatchDomain> domains_;                       // the drawn patches, whole or cut
+  std::vector<std::array<int, 4>> corners_;                // welded corner vertices per domain
   std::vector<std::array<std::vector<Piece>, 4>> pieces_;  // per domain and side
-  std::map<std::pair<int, int>, int> segments_;           // per piece, by its welded ends
+  std::map<std::pair<int, int>, int> segments_;            // per piece, by its welded ends
   std::map<std::pair<int, int>, std::vector<int>> edgeVertices_;
   size_t triangles_ = 0;
   TessellationStats stats_;
@@ -725,8 +726,8 @@ namespace {
 // `make(tessellator)` for a Tessellator with `options`, retried with a coarser dicing rate while
 // the factors exceed maxTriangles (when options.fitToBudget); the rate used goes into the stats.
 template <typename Make>
-auto withinBudget(const PatchSet& patches, const Camera& camera,
-                  const TessellationOptions& options, const CancelToken& cancel, Make make) {
+auto withinBudget(const PatchSet& patches, const Camera& camera, const TessellationOptions& options,
+                  const CancelToken& cancel, Make make) {
   TessellationOptions tried = options;
   for (int attempt = 0;; ++attempt) {
     try {

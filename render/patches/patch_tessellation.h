@@ -73,7 +73,7 @@ struct SidePiece {
 struct TessellationPlan {
   std::vector<PatchDomain> domains;
   std::vector<std::array<std::vector<SidePiece>, 4>> sides;  // per domain; 3 used by triangles
-  size_t triangles = 0;  // what tessellatePatches() makes of it
+  size_t triangles = 0;                                      // what tessellatePatches() makes of it
   TessellationStats stats;
 };
 

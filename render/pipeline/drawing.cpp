@@ -140,8 +140,8 @@ void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice
   // At 1 px and 1024^2 a coarse Loop mesh would ask for 10M+ triangles (adaptive caps its
   // faces' edges at 128 segments instead): the rate is coarsened to fit, and said.
   options.fitToBudget = true;
-  patches::PatchMesh tessellation = dicePatches(set, options, choice.params.tessellator, context,
-                                                camera, cancel, stats);
+  patches::PatchMesh tessellation =
+      dicePatches(set, options, choice.params.tessellator, context, camera, cancel, stats);
   if (tessellation.stats.dicingRate > options.dicingRate) {
     out.warnings.push_back("params.dicingRate raised from " + formatRate(options.dicingRate) +
                            " to " + formatRate(tessellation.stats.dicingRate) +
@@ -166,8 +166,8 @@ namespace {
 
 // The patches method: Far's feature-adaptive patch table, tessellated for the camera.
 void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
-                            const Camera& camera, RenderContext* context,
-                            const CancelToken& cancel, Approximated& out) {
+                            const Camera& camera, RenderContext* context, const CancelToken& cancel,
+                            Approximated& out) {
   const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel);
   tessellatePatchSet(set, choice, limits, camera, context, cancel, out);
 }
@@ -210,9 +210,9 @@ MethodDrawing drawMethod(const MethodChoice& choice, const JobLimits& limits,
                          const subdiv::LimitSurface& surface, const Camera& camera,
                          RenderContext& context, bool measured, int supersample,
                          const CancelToken& cancel) {
-  return rasterizeApproximation(approximateMethod(choice, limits, surface, camera, &context, cancel),
-                                choice,
-                                surface, camera, context, measured, supersample, cancel);
+  return rasterizeApproximation(
+      approximateMethod(choice, limits, surface, camera, &context, cancel), choice, surface, camera,
+      context, measured, supersample, cancel);
 }
 
 MethodDrawing rasterizeApproximation(Approximated approx, const MethodChoice& choice,

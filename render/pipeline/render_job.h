@@ -46,7 +46,7 @@ struct MethodParams {
   bool pushToLimit = false;            // uniform: move every refined vertex to its limit position
   double dicingRate = 1.0;             // adaptive, patches: target edge length in pixels
   int isolation = patches::kDefaultIsolation;  // patches: Far's adaptive isolation level
-  bool cullPatches = true;    // patches: leave out patches outside the view or facing away
+  bool cullPatches = true;  // patches: leave out patches outside the view or facing away
   // patches: who dices the patches, the CPU (welded, shared edge vertices) or the GPU's
   // tessellation stages (the same factors; llvmpipe where there is no GPU).
   PatchTessellator tessellator = PatchTessellator::Cpu;

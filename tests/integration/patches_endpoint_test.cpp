@@ -8,8 +8,8 @@
 
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <csignal>
+#include <cstdio>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -199,18 +199,17 @@ int differingPixels(const render::Image& a, const render::Image& b, float tolera
 // creases: the CPU path shares one vertex, hence one normal, between the two sides of a crease;
 // the GPU path's patches each keep their own.)
 TEST_F(PatchesEndpointTest, GpuTessellatorDrawsTheCpuPicture) {
-  for (const NamedMesh& shape :
-       selectShapes(ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_cube_sharp_corners",
-                                  "own_icosahedron_loop", "own_sharp_tetrahedron_loop",
-                                  "own_pawn_588"})) {
+  for (const NamedMesh& shape : selectShapes(
+           ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_cube_sharp_corners",
+                         "own_icosahedron_loop", "own_sharp_tetrahedron_loop", "own_pawn_588"})) {
     std::array<render::Image, 2> mask;
     std::array<int, 2> offReference{};
     int covered = 0;
     for (int gpu = 0; gpu < 2; ++gpu) {
-      const std::string params = std::string(R"({"dicingRate": 1, "tessellator": ")") +
-                                 (gpu ? "gpu" : "cpu") + R"("})";
-      HttpResponse r = post(port(), "/v1/render",
-                            patchesRequest(shape, 256, params, R"(["color", "mask"])"));
+      const std::string params =
+          std::string(R"({"dicingRate": 1, "tessellator": ")") + (gpu ? "gpu" : "cpu") + R"("})";
+      HttpResponse r =
+          post(port(), "/v1/render", patchesRequest(shape, 256, params, R"(["color", "mask"])"));
       ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
       auto doc = parseJson(r.body);
       EXPECT_LE(doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 1.0) << shape.name;
@@ -225,9 +224,10 @@ TEST_F(PatchesEndpointTest, GpuTessellatorDrawsTheCpuPicture) {
       for (int x = 0; x < mask[0].width; ++x) covered += mask[0].at(x, y, 0) > 0.5f;
     }
     const int maskOff = differingPixels(mask[0], mask[1], 0.5f);
-    std::printf("gpu vs cpu tessellator, %s: %d of %d covered pixels differ in the mask; colour "
-                "off the reference by more than 8/255: cpu %d, gpu %d pixels\n",
-                shape.name.c_str(), maskOff, covered, offReference[0], offReference[1]);
+    std::printf(
+        "gpu vs cpu tessellator, %s: %d of %d covered pixels differ in the mask; colour "
+        "off the reference by more than 8/255: cpu %d, gpu %d pixels\n",
+        shape.name.c_str(), maskOff, covered, offReference[0], offReference[1]);
     EXPECT_GT(covered, 2000) << shape.name;
     EXPECT_LE(maskOff, covered / 1000 + 2) << shape.name;
     EXPECT_LE(offReference[1], offReference[0] + covered / 200) << shape.name;
@@ -305,10 +305,9 @@ TEST_F(PatchesEndpointTest, GpuTessellatorDrawsFramesAndIsNotForDownloads) {
     EXPECT_TRUE(frame["images"].HasMember("patches"));
     EXPECT_GT(frame["triangles"].GetUint64(), 0u);
   }
-  HttpResponse download = post(
-      port(), "/v1/tessellate",
-      R"({"mesh": )" + requestMeshJson(torus.mesh) +
-          R"(, "method": "patches", "params": {"tessellator": "gpu"}})");
+  HttpResponse download = post(port(), "/v1/tessellate",
+                               R"({"mesh": )" + requestMeshJson(torus.mesh) +
+                                   R"(, "method": "patches", "params": {"tessellator": "gpu"}})");
   EXPECT_EQ(download.status, 400) << download.body.substr(0, 300);
   EXPECT_EQ(errorField(download), "params.tessellator") << download.body.substr(0, 300);
 }

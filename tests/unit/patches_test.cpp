@@ -387,11 +387,9 @@ TEST_F(GpuTessellation, KeepsTheWindingAndCutDomainsAndBatches) {
     const PatchMesh batched = small.tessellate(set, plan, CancelToken(), &smallStats);
     EXPECT_GT(smallStats.draws, stats.draws) << name;
     ASSERT_EQ(batched.mesh.positions.size(), gpu.mesh.positions.size()) << name;
-    EXPECT_TRUE(std::equal(batched.mesh.positions.begin(), batched.mesh.positions.end(),
-                           gpu.mesh.positions.begin(),
-                           [](const Vec3f& a, const Vec3f& b) {
-                             return a.x == b.x && a.y == b.y && a.z == b.z;
-                           }))
+    EXPECT_TRUE(std::equal(
+        batched.mesh.positions.begin(), batched.mesh.positions.end(), gpu.mesh.positions.begin(),
+        [](const Vec3f& a, const Vec3f& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }))
         << name;
   }
 }
@@ -408,7 +406,8 @@ TEST_F(GpuTessellation, EvaluatesBoundaryPatchesOfOpenMeshes) {
     PatchSet set(m, subdiv::kApproxLevel, CancelToken());
     TessellationOptions options;
     options.dicingRate = 3;
-    const TessellationPlan plan = planPatchTessellation(set, viewOf(set, 2), options, CancelToken());
+    const TessellationPlan plan =
+        planPatchTessellation(set, viewOf(set, 2), options, CancelToken());
     const PatchMesh gpu = tessellator_->tessellate(set, plan, CancelToken());
     ASSERT_GT(gpu.mesh.triangleCount(), 0u);
     expectOnTheLimitSurface(gpu.mesh, surface, "grid");
