@@ -3,7 +3,6 @@
 #include <opensubdiv/osd/glslPatchShaderSource.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -261,10 +260,22 @@ DomainBound domainBound(bool triangle, const std::array<float, kLevelFloats>& le
   return {2 * a * b + outer, a * b + outer};
 }
 
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
+// The draw state the tessellator sets, undone however it leaves (the rasterizer draws next).
+struct DrawState {
+  DrawState(GLuint framebuffer, GLuint vertexArray) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glBindVertexArray(vertexArray);
+    glPatchParameteri(GL_PATCH_VERTICES, 1);
+    glEnable(GL_RASTERIZER_DISCARD);
+  }
+  ~DrawState() {
+    glDisable(GL_RASTERIZER_DISCARD);
+    glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+  DrawState(const DrawState&) = delete;
+  DrawState& operator=(const DrawState&) = delete;
+};
 
 }  // namespace
 
@@ -406,21 +417,16 @@ int GpuPatchTessellator::maxTessLevel() const { return impl_->maxTessLevel; }
 
 PatchMesh GpuPatchTessellator::tessellate(const PatchSet& set, const TessellationPlan& plan,
                                           const CancelToken& cancel, GpuTessellationStats* stats) {
-  const auto start = std::chrono::steady_clock::now();
   GpuTessellationStats counted;
-  counted.domainsPerDraw = impl_->domainsPerDraw;
   std::vector<std::array<float, kLevelFloats>> levels;
   impl_->upload(set, plan, levels);
 
   const bool triangle = set.scheme() == mesh::Scheme::Loop;
   const ShaderProgram& program = triangle ? impl_->triangles : impl_->quads;
   program.use();
-  glBindFramebuffer(GL_FRAMEBUFFER, impl_->framebuffer);
-  glBindVertexArray(impl_->vertexArray);
-  glPatchParameteri(GL_PATCH_VERTICES, 1);
-  glEnable(GL_RASTERIZER_DISCARD);
   std::vector<CapturedVertex> captured;
-  try {
+  {
+    const DrawState state(impl_->framebuffer, impl_->vertexArray);
     for (size_t first = 0; first < plan.domains.size();) {
       cancel.check();
       size_t count = 0;
@@ -440,17 +446,9 @@ PatchMesh GpuPatchTessellator::tessellate(const PatchSet& set, const Tessellatio
       ++counted.draws;
       first += count;
     }
-  } catch (...) {
-    glDisable(GL_RASTERIZER_DISCARD);
-    glBindVertexArray(0);
-    throw;
   }
-  glDisable(GL_RASTERIZER_DISCARD);
-  glBindVertexArray(0);
-  counted.gpuMs = msSince(start);
   cancel.check();
 
-  const auto assembling = std::chrono::steady_clock::now();
   PatchMesh out;
   out.stats = plan.stats;
   tessellate::TriangleMesh& mesh = out.mesh;
@@ -480,7 +478,6 @@ PatchMesh GpuPatchTessellator::tessellate(const PatchSet& set, const Tessellatio
       }
     }
   });
-  counted.assembleMs = msSince(assembling);
   if (stats) *stats = counted;
   return out;
 }

@@ -29,15 +29,12 @@
 namespace limn::render::patches {
 
 struct GpuTessellationStats {
-  size_t draws = 0;           // draw calls (batches of domains)
-  size_t domainsPerDraw = 0;  // the batch size used
-  double gpuMs = 0;           // uploads, draws and read-back
-  double assembleMs = 0;      // the read-back turned into the mesh (face (u, v) per corner)
+  size_t draws = 0;  // draw calls (batches of domains)
 };
 
 class GpuPatchTessellator {
  public:
-  // The batch size used unless told otherwise (bench/patches_bench measures others).
+  // The most domains one draw takes unless told otherwise.
   static constexpr int kDefaultDomainsPerDraw = 1024;
 
   // Compiles the programs. Throws std::runtime_error when the context has no tessellation

@@ -8,6 +8,7 @@
 #include <map>
 #include <numbers>
 #include <tuple>
+#include <unordered_map>
 
 #include "render/patches/gpu_tessellation.h"
 #include "render/patches/patch_set.h"
@@ -260,7 +261,12 @@ GpuPatchTessellator* GpuTessellation::tessellator_ = nullptr;
 // The triangles' vertices welded within `tolerance` (the GPU path's sides evaluate shared
 // vertices in their own patches, in float): an id per corner.
 std::vector<int> weldedCorners(const tessellate::TriangleMesh& mesh, double tolerance) {
-  std::map<std::tuple<int64_t, int64_t, int64_t>, std::vector<int>> cells;
+  struct CellHash {
+    size_t operator()(const std::tuple<int64_t, int64_t, int64_t>& c) const {
+      return std::get<0>(c) * 73856093u ^ std::get<1>(c) * 19349663u ^ std::get<2>(c) * 83492791u;
+    }
+  };
+  std::unordered_map<std::tuple<int64_t, int64_t, int64_t>, std::vector<int>, CellHash> cells;
   std::vector<Vec3> representatives;
   std::vector<int> out;
   for (uint32_t index : mesh.indices) {
@@ -381,7 +387,8 @@ TEST_F(GpuTessellation, KeepsTheWindingAndCutDomainsAndBatches) {
     }
     EXPECT_GT(agree, counted * 999 / 1000) << name;
 
-    // Small batches: more draws, the same triangles in the same order.
+    // Small batches: more draws, the same triangles in the same order (one mesh per scheme).
+    if (name != "cube" && name != "loop icosahedron") continue;
     GpuPatchTessellator small(7);
     GpuTessellationStats smallStats;
     const PatchMesh batched = small.tessellate(set, plan, CancelToken(), &smallStats);
