@@ -10,11 +10,14 @@ endfunction()
 # Tests find their data through LIMN_SOURCE_DIR (tests/data, ../shared/corpus).
 # SLOW marks a program whose cases take minutes (the corpus at 1024^2): they carry the CTest
 # label "slow", which `scripts/test.sh --quick` leaves out.
+# HEAVY marks a program of many full renders at a few hundred pixels whose engine code the unit
+# suites also cover: label "heavy" as well, which scripts/sanitize.sh leaves out (under the
+# sanitizers each such program takes minutes).
 # SHARDS n (programs that start a `limn serve` per test suite): CTest runs the program as n
 # processes, each taking every n-th case (GoogleTest sharding), instead of one process per case,
 # so that a server is started n times rather than once per case. Each shard is one CTest test.
 function(limn_test name)
-  cmake_parse_arguments(ARG "SLOW" "SHARDS" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "SLOW;HEAVY" "SHARDS" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE LIMN_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
@@ -23,8 +26,11 @@ function(limn_test name)
   else()
     set(label quick)
   endif()
+  if(ARG_HEAVY)
+    list(APPEND label heavy)
+  endif()
   if(NOT ARG_SHARDS)
-    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 1200 LABELS ${label})
+    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 1200 LABELS "${label}")
     return()
   endif()
   math(EXPR last "${ARG_SHARDS} - 1")
@@ -32,6 +38,6 @@ function(limn_test name)
     add_test(NAME ${name}/shard${shard} COMMAND ${name})
     set_tests_properties(${name}/shard${shard} PROPERTIES
       ENVIRONMENT "GTEST_TOTAL_SHARDS=${ARG_SHARDS};GTEST_SHARD_INDEX=${shard}"
-      TIMEOUT 1800 LABELS ${label})
+      TIMEOUT 1800 LABELS "${label}")
   endforeach()
 endfunction()

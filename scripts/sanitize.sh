@@ -2,7 +2,8 @@
 # The quality-gate build: every target compiled by clang with AddressSanitizer and
 # UndefinedBehaviorSanitizer (and libFuzzer's coverage instrumentation, so that the fuzz
 # targets come from the same tree) into build-sanitize/, then the quick test suite run in it.
-# Usage: scripts/sanitize.sh [ctest arguments...]   (default: -LE slow)
+# Usage: scripts/sanitize.sh [ctest arguments...]   (default: -LE 'slow|heavy': the quick suite
+# less the programs of many full renders, whose engine code the unit tests run sanitized)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -27,6 +28,6 @@ cmake --build build-sanitize -j "$jobs"
 # with leak detection on.
 export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:strict_string_checks=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-[ $# -eq 0 ] && set -- -LE slow
+[ $# -eq 0 ] && set -- -LE 'slow|heavy'
 cd build-sanitize
 ctest --output-on-failure -j "${LIMN_TEST_JOBS:-1}" "$@"
