@@ -168,10 +168,10 @@ CompareRequest parseDocument(const Value& root, const JobLimits& limits,
   }
   CompareRequest request;
   render::pipeline::CompareJob& job = request.job;
-  request::warnUnknownFields(
-      root, "",
-      {"mesh", "camera", "cameras", "methods", "metricSupersample", "outputs", "imageFormat"},
-      request.warnings);
+  request::warnUnknownFields(root, "",
+                             {"mesh", "camera", "cameras", "methods", "metricSupersample",
+                              "outputs", "imageFormat", "displacement"},
+                             request.warnings);
   parseCameras(root, limits, request);
   const Value* methods = json::find(root, "methods");
   if (!methods) json::fail("methods", "methods is required: the methods to compare");
@@ -208,6 +208,9 @@ CompareRequest parseDocument(const Value& root, const JobLimits& limits,
   const Value* mesh = json::find(root, "mesh");
   if (!mesh) json::fail("mesh", "mesh is required");
   job.mesh = request::parseMesh(*mesh, limits, request.warnings, meshes);
+  if (const Value* v = json::find(root, "displacement")) {
+    job.displacement = request::parseDisplacement(*v, request.warnings);
+  }
   for (size_t c = 0; c < job.cameras.size(); ++c) {
     const std::string name =
         json::find(root, "cameras") ? "cameras[" + std::to_string(c) + "]" : "camera";

@@ -89,7 +89,7 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
   warnUnknownFields(params, "params",
                     {"level", "engine", "pushToLimit", "dicingRate", "metricSupersample",
                      "referenceCrossCheck", "presubdivide", "searchSteps", "curveSamples",
-                     "contour", "isolation", "cullPatches", "tessellator"},
+                     "contour", "isolation", "cullPatches", "tessellator", "retessellateFrames"},
                     warnings);
   render::pipeline::MethodParams out;
   if (const Value* v = json::find(params, "level")) {
@@ -130,6 +130,9 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
                          " exceeds limit maxIsolation (" + std::to_string(limits.maxIsolation) +
                          ")");
     }
+  }
+  if (const Value* v = json::find(params, "retessellateFrames")) {
+    out.retessellateFrames = json::boolean(*v, "params.retessellateFrames");
   }
   if (const Value* v = json::find(params, "cullPatches")) {
     out.cullPatches = json::boolean(*v, "params.cullPatches");
@@ -280,7 +283,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   render::pipeline::RenderJob& job = request.job;
   warnUnknownFields(root, "",
                     {"mesh", "camera", "method", "params", "shading", "outputs", "reference",
-                     "imageFormat", "frames"},
+                     "imageFormat", "frames", "displacement"},
                     warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
@@ -321,6 +324,9 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   if (!mesh) json::fail("mesh", "mesh is required");
   job.mesh = parseMesh(*mesh, limits, warnings, meshes);
   if (const Value* v = json::find(root, "frames")) job.frames = readFrames(*v, job, limits);
+  if (const Value* v = json::find(root, "displacement")) {
+    job.displacement = request::parseDisplacement(*v, warnings);
+  }
 
   request::checkCameraAgainstMesh(job.camera, job.mesh);
   return request;
@@ -368,6 +374,24 @@ void parseSilhouetteParams(const Value& params, const JobLimits& limits,
 }
 
 render::pipeline::Outputs parseOutputs(const Value& outputs) { return readOutputs(outputs); }
+
+render::subdiv::DisplacementSpec parseDisplacement(const Value& displacement,
+                                                   std::vector<std::string>& warnings) {
+  using render::subdiv::DisplacementFunction;
+  json::requireObject(displacement, "displacement");
+  warnUnknownFields(displacement, "displacement", {"function", "amplitude", "frequency"}, warnings);
+  render::subdiv::DisplacementSpec out;
+  const Value* function = json::find(displacement, "function");
+  if (!function) json::fail("displacement.function", "displacement.function is required");
+  out.function = json::choice<DisplacementFunction>(
+      *function, "displacement.function",
+      {{"bumps", DisplacementFunction::Bumps}, {"ripples", DisplacementFunction::Ripples}});
+  const Value* amplitude = json::find(displacement, "amplitude");
+  const Value* frequency = json::find(displacement, "frequency");
+  out.amplitude = amplitude ? json::number(*amplitude, "displacement.amplitude") : 0.02;
+  out.frequency = frequency ? json::number(*frequency, "displacement.frequency") : 4;
+  return out;
+}
 
 render::Shading parseShading(const Value& shading) {
   return json::choice<render::Shading>(shading, "shading",

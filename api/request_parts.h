@@ -18,6 +18,7 @@
 #include "render/mesh/mesh_cache.h"
 #include "render/pipeline/compare.h"
 #include "render/pipeline/render_job.h"
+#include "render/subdiv/displacement.h"
 
 namespace limn::api::request {
 
@@ -72,6 +73,11 @@ void checkCameraAgainstMesh(const render::CameraSpec& camera,
                             const render::mesh::ControlMesh& mesh);
 // The same against any surface's bounding box (an implicit field's domain).
 void checkCameraAgainstBounds(const render::CameraSpec& camera, const render::Bounds& bounds);
+
+// "displacement": {"function": "bumps" | "ripples", "amplitude", "frequency"} (ranges are the
+// engine's to check: pipeline::checkDisplacement).
+render::subdiv::DisplacementSpec parseDisplacement(const rapidjson::Value& displacement,
+                                                   std::vector<std::string>& warnings);
 
 // "outputs": ["color", "mask", ...] (400 naming the element that is not an output's name).
 render::pipeline::Outputs parseOutputs(const rapidjson::Value& outputs);

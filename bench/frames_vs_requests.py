@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Animation through a running server: one /v1/render request with 30 frames of a breathing
-example mesh (method patches, 512 x 512, dicing rate 4) against 30 separate requests of the
-same frames. Prints one Markdown row per example (bench/patches_results.md keeps them).
+example mesh (method patches, 512 x 512, dicing rate 4; the first frame's tessellation re-evaluated
+for the others) against the same request with params.retessellateFrames (every frame diced anew)
+and against 30 separate requests of the same frames. Prints one Markdown row per example
+(bench/patches_results.md keeps them).
 
     build/bin/limn serve --listen 127.0.0.1:8099 &
     bench/frames_vs_requests.py [URL] [EXAMPLE ...]   # defaults: http://127.0.0.1:8099, torus_creased pawn cube
@@ -35,6 +37,8 @@ def measure(name):
     post(dict(base))  # warm up
     answer, batch = post(dict(base, frames=frames))
     assert len(answer["frames"]) == 30, answer.get("error")
+    anew = dict(base, frames=frames, params={"dicingRate": 4, "retessellateFrames": True})
+    _, diced = post(anew)
     single = 0
     for f in range(30):
         it = iter(frames[f])
@@ -42,10 +46,10 @@ def measure(name):
         _, ms = post(dict(base, mesh={"format": "obj", "data": text}))
         single += ms
     per = [fr["approxMs"] + fr["rasterMs"] for fr in answer["frames"]]
-    print(f"| {name} | {len(points)} | {batch/30:.1f} | {single/30:.1f} | {single/batch:.2f}x | {sum(per)/30:.1f} | {answer['stats']['patchTable']['tableMs']:.1f} |")
+    print(f"| {name} | {len(points)} | {batch/30:.1f} | {diced/30:.1f} | {single/30:.1f} | {diced/batch:.2f}x | {single/batch:.2f}x | {sum(per)/30:.1f} | {answer['stats']['patchTable']['tableMs']:.1f} |")
 
 
-print("| mesh | points | ms/frame, one request of 30 frames | ms/frame, 30 requests | 30 requests / one | engine ms/frame (tessellate + raster) | table ms |")
-print("|---|---:|---:|---:|---:|---:|---:|")
+print("| mesh | points | ms/frame, one request (tessellation reused) | ms/frame, one request (retessellateFrames) | ms/frame, 30 requests | retessellated / reused | 30 requests / reused | engine ms/frame (approx + raster), reused | table ms |")
+print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
 for example in EXAMPLES:
     measure(example)

@@ -104,7 +104,7 @@ std::shared_ptr<const ReferenceScene> buildReferenceScene(const subdiv::LimitSur
   return scene;
 }
 
-std::string referenceSceneKey(const mesh::ControlMesh& mesh, const Camera& c) {
+std::string referenceSceneKey(const subdiv::LimitSurface& surface, const Camera& c) {
   char view[512];
   std::snprintf(
       view, sizeof view,
@@ -112,14 +112,14 @@ std::string referenceSceneKey(const mesh::ControlMesh& mesh, const Camera& c) {
       c.eye().x, c.eye().y, c.eye().z, c.target().x, c.target().y, c.target().z, c.up().x, c.up().y,
       c.up().z, c.fovYDeg(), static_cast<int>(c.projection()), c.orthoHeight(), c.width(),
       c.height(), c.nearPlane(), c.farPlane());
-  return mesh::contentHash(mesh) + view;
+  return mesh::contentHash(surface.mesh()) + "|" + surface.displacementSpec().key() + view;
 }
 
 std::shared_ptr<const ReferenceScene> ReferenceSceneCache::get(const subdiv::LimitSurface& surface,
                                                                const Camera& camera,
                                                                const CancelToken& cancel,
                                                                bool* hit) {
-  const std::string key = referenceSceneKey(surface.mesh(), camera);
+  const std::string key = referenceSceneKey(surface, camera);
   {
     std::lock_guard lock(mutex_);
     auto it = index_.find(key);

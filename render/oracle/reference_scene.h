@@ -40,8 +40,8 @@ std::shared_ptr<const ReferenceScene> buildReferenceScene(const subdiv::LimitSur
                                                           const Camera& camera,
                                                           const CancelToken& cancel);
 
-// The cache key: the mesh's content hash and every camera parameter.
-std::string referenceSceneKey(const mesh::ControlMesh& mesh, const Camera& camera);
+// The cache key: the mesh's content hash, its displacement and every camera parameter.
+std::string referenceSceneKey(const subdiv::LimitSurface& surface, const Camera& camera);
 
 class ReferenceSceneCache {
  public:

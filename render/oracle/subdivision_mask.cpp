@@ -36,6 +36,7 @@ constexpr double kCrackProbesPx[] = {0.05, 0.25};
 // Why Embree cannot represent this mesh as OpenSubdiv subdivides it, or "" when it can.
 std::string unsupportedReason(const subdiv::LimitSurface& surface) {
   const mesh::ControlMesh& m = surface.mesh();
+  if (surface.displaced()) return "Embree's subdivision geometry is drawn without displacement";
   if (m.scheme != mesh::Scheme::CatmullClark) {
     return std::string("Embree subdivision geometry is Catmull-Clark only; the mesh is ") +
            mesh::schemeName(m.scheme);

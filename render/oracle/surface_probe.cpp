@@ -15,6 +15,9 @@ namespace {
 
 // Samples per face edge (a uniform Bfr tessellation at this rate).
 constexpr int kProbeRate = 4;
+// On a displaced surface: bumps of the highest frequency allowed are a few per face of a coarse
+// mesh, and the facing must be sampled within each.
+constexpr int kDisplacedProbeRate = 16;
 // Sampled curvature underestimates peaks between samples: segments use this multiple.
 constexpr double kCurvatureSafety = 2.0;
 
@@ -23,7 +26,8 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
   probe.probed = true;
   Bfr::Parameterization param = surface.parameterization(face);
   const int n = param.GetFaceSize();
-  Bfr::Tessellation tess(param, kProbeRate);
+  const int rate = surface.displaced() ? kDisplacedProbeRate : kProbeRate;
+  Bfr::Tessellation tess(param, rate);
   std::vector<double> uv(2 * tess.GetNumCoords());
   tess.GetCoords(uv.data());
   std::vector<int> facets(3 * tess.GetNumFacets());
@@ -53,20 +57,20 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
   double tau = 0.05 + probe.normalSpread;
   probe.silhouette = probe.gMin < tau && probe.gMax > -tau;
 
-  // Boundary coords run corner 0, the kProbeRate - 1 points of edge 0, corner 1, ...
+  // Boundary coords run corner 0, the rate - 1 points of edge 0, corner 1, ...
   probe.segmentsAtOnePixel.resize(n);
   probe.lengthPx.resize(n);
-  const int boundary = n * kProbeRate;
+  const int boundary = n * rate;
   for (int k = 0; k < n; ++k) {
-    Vec3 p[kProbeRate + 1];
+    std::vector<Vec3> p(rate + 1);
     double minDepth = 1e300;
-    for (int i = 0; i <= kProbeRate; ++i) {
-      p[i] = samples[(k * kProbeRate + i) % boundary].position;
+    for (int i = 0; i <= rate; ++i) {
+      p[i] = samples[(k * rate + i) % boundary].position;
       minDepth = std::min(minDepth, camera.depthOf(p[i]));
     }
     double length3 = 0, edgeKappa = 0;
-    for (int i = 0; i < kProbeRate; ++i) length3 += length(p[i + 1] - p[i]);
-    for (int i = 1; i < kProbeRate; ++i) {
+    for (int i = 0; i < rate; ++i) length3 += length(p[i + 1] - p[i]);
+    for (int i = 1; i < rate; ++i) {
       double h = 0.5 * (length(p[i] - p[i - 1]) + length(p[i + 1] - p[i]));
       if (h > 0) {
         edgeKappa = std::max(edgeKappa, length(p[i - 1] - p[i] * 2.0 + p[i + 1]) / (h * h));

@@ -72,8 +72,11 @@ const char* patchKindName(PatchKind kind) {
   return "?";
 }
 
-PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel)
-    : scheme_(mesh.scheme), controlPoints_(mesh.points.size()) {
+PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel,
+                   const subdiv::DisplacementSpec& displacement)
+    : scheme_(mesh.scheme),
+      controlPoints_(mesh.points.size()),
+      displacement_(displacement, mesh.bounds()) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<Far::TopologyRefiner> refiner = subdiv::createTopologyRefiner(mesh);
   const Far::TopologyLevel& base = refiner->GetLevel(0);
@@ -128,7 +131,9 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
       patch.kind = kindOf(descriptor.GetType(), patch.param, onBoundary[face]);
       patch.triangle = triangle;
       patch.inHull = patch.param.GetBoundary() == 0;
-      patch.cullable = descriptor.GetType() == Far::PatchDescriptor::REGULAR && patch.inHull;
+      // Displaced, a patch's normals leave the cone of its control points' differences.
+      patch.cullable = descriptor.GetType() == Far::PatchDescriptor::REGULAR && patch.inHull &&
+                       !displacement_.enabled();
       if (static_cast<int>(stats_.byLevel.size()) <= patch.depth) {
         stats_.byLevel.resize(patch.depth + 1, {});
       }
@@ -157,6 +162,10 @@ void PatchSet::setControlPoints(const std::vector<Vec3>& points) {
   }
   controlBounds_ = Bounds{};
   for (const Vec3& p : points) controlBounds_.extend(p);
+  if (const double reach = displacement_.reach(); reach > 0) {
+    controlBounds_.extend(controlBounds_.lo - Vec3{reach, reach, reach});
+    controlBounds_.extend(controlBounds_.hi + Vec3{reach, reach, reach});
+  }
   points_.resize(buffer.size());
   for (size_t i = 0; i < buffer.size(); ++i) points_[i] = buffer[i].p;
 }
@@ -182,11 +191,10 @@ Vec2 PatchSet::toFaceUV(const Patch& patch, double s, double t) const {
   return {uv[0], uv[1]};
 }
 
-void PatchSet::evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds,
-                        Vec3& dt) const {
-  const Vec2 at = toPtex(patch, s, t);
+void PatchSet::evaluateUndisplaced(const Patch& patch, Vec2 ptex, Vec3& position, Vec3& ds,
+                                   Vec3& dt) const {
   std::array<double, kMaxPatchPoints> w, wDs, wDt;
-  table_->EvaluateBasis(patch.handle, at.x, at.y, w.data(), wDs.data(), wDt.data());
+  table_->EvaluateBasis(patch.handle, ptex.x, ptex.y, w.data(), wDs.data(), wDt.data());
   Far::ConstIndexArray cvs = table_->GetPatchVertices(patch.handle);
   position = ds = dt = Vec3{0, 0, 0};
   for (int i = 0; i < cvs.size(); ++i) {
@@ -195,6 +203,30 @@ void PatchSet::evaluate(const Patch& patch, double s, double t, Vec3& position, 
     ds += p * wDs[i];
     dt += p * wDt[i];
   }
+}
+
+subdiv::SurfaceJet PatchSet::evaluateJet(const Patch& patch, Vec2 ptex) const {
+  return subdiv::evaluateFarJet(*table_, patch.handle, ptex.x, ptex.y, points_);
+}
+
+void PatchSet::evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds,
+                        Vec3& dt) const {
+  if (!displacement_.enabled()) {
+    evaluateUndisplaced(patch, toPtex(patch, s, t), position, ds, dt);
+    return;
+  }
+  const subdiv::SurfaceJet jet = evaluateJet(patch, toPtex(patch, s, t));
+  if (subdiv::displace(displacement_, jet, position, ds, dt)) return;
+  // The patch normal is undefined here (some end-cap corners): the normal and its derivatives
+  // are their limits from a point nudged towards the patch's centre.
+  const double centre = patch.triangle ? 1.0 / 3.0 : 0.5;
+  subdiv::SurfaceJet near =
+      evaluateJet(patch, toPtex(patch, s + (centre - s) * 1e-5, t + (centre - t) * 1e-5));
+  near.position = jet.position;
+  if (subdiv::displace(displacement_, near, position, ds, dt)) return;
+  position = jet.position;
+  ds = jet.du;
+  dt = jet.dv;
 }
 
 Far::ConstIndexArray PatchSet::pointIndices(const Patch& patch) const {

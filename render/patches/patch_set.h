@@ -20,6 +20,7 @@
 #include "render/core/cancel.h"
 #include "render/core/vec.h"
 #include "render/mesh/control_mesh.h"
+#include "render/subdiv/displacement.h"
 
 namespace limn::render::patches {
 
@@ -66,7 +67,10 @@ class PatchSet {
  public:
   // Throws InputError(InvalidMesh) when OpenSubdiv rejects the topology; checks `cancel`
   // between the stages.
-  PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel);
+  // `displacement` (resolved against the mesh's bounds, kept for every frame) moves every
+  // evaluated point along the patch normal; no patch is then culled for facing away.
+  PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel,
+           const subdiv::DisplacementSpec& displacement = {});
   ~PatchSet();
   PatchSet(const PatchSet&) = delete;
   PatchSet& operator=(const PatchSet&) = delete;
@@ -81,11 +85,14 @@ class PatchSet {
   mesh::Scheme scheme() const { return scheme_; }
   // No boundary, non-manifold edge or hole: seen from outside, back-facing patches are hidden.
   bool closed() const { return closed_; }
-  // The control points' bounds, which hold the whole surface (its points are convex
-  // combinations of them).
+  // The control points' bounds, widened by the displacement's reach: they hold the whole
+  // surface (its points are convex combinations of the control points, then displaced).
   const Bounds& controlBounds() const { return controlBounds_; }
+  // How far displacement may move a point off the patches' hull (0: not displaced).
+  double displacementReach() const { return displacement_.reach(); }
 
-  // Position and first derivatives at patch-local (s, t): [0,1]^2, or the unit triangle.
+  // Position and first derivatives at patch-local (s, t): [0,1]^2, or the unit triangle; of the
+  // displaced surface when there is a displacement.
   void evaluate(const Patch& patch, double s, double t, Vec3& position, Vec3& ds, Vec3& dt) const;
   // The patch's local (s, t) in its Ptex face's coordinates (a sub-face's for n-gons).
   Vec2 toPtex(const Patch& patch, double s, double t) const;
@@ -105,11 +112,15 @@ class PatchSet {
   bool closed_ = false;
   Bounds controlBounds_;
   size_t controlPoints_ = 0;
+  subdiv::Displacement displacement_;
   std::unique_ptr<OpenSubdiv::Far::PatchTable> table_;
   std::unique_ptr<const OpenSubdiv::Far::StencilTableReal<double>> stencils_;
   std::vector<Vec3> points_;  // control, refined and end-cap points, as the table indexes them
   std::vector<Patch> patches_;
   PatchTableStats stats_;
+
+  void evaluateUndisplaced(const Patch& patch, Vec2 ptex, Vec3& position, Vec3& ds, Vec3& dt) const;
+  subdiv::SurfaceJet evaluateJet(const Patch& patch, Vec2 ptex) const;
 };
 
 }  // namespace limn::render::patches

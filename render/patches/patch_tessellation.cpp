@@ -114,18 +114,19 @@ Vec2 corner(const PatchDomain& domain, int k) {
 
 struct Sample {
   Vec3 position, normal;
+  VertexSource source;  // where it was evaluated
 };
 
-// Position and unit normal at the domain's (a, b); where the derivatives vanish (some end-cap
-// corners), the normal a little way towards the domain's centre.
-Sample evaluateSample(const PatchSet& set, const PatchDomain& domain, Vec2 ab) {
-  const Patch& patch = set.patches()[domain.patch];
+// Position and unit normal at the patch's (s, t); where the derivatives vanish (some end-cap
+// corners), the normal a little way towards `centre`.
+Sample evaluateAt(const PatchSet& set, const VertexSource& source) {
+  const Patch& patch = set.patches()[source.patch];
   Sample out;
+  out.source = source;
   Vec3 ds, dt;
-  const Vec2 st = domain.toPatch(ab);
+  const Vec2 st = source.st, centre = source.towards;
   set.evaluate(patch, st.x, st.y, out.position, ds, dt);
   Vec3 n = cross(ds, dt);
-  const Vec2 centre = domain.toPatch(domain.triangle ? Vec2{1.0 / 3, 1.0 / 3} : Vec2{0.5, 0.5});
   for (double step = 1e-4; length(n) <= 1e-12 * length(ds) * length(dt) && step < 0.5; step *= 10) {
     Vec3 ignored;
     const Vec2 in = lerp(st, centre, step);
@@ -135,6 +136,12 @@ Sample evaluateSample(const PatchSet& set, const PatchDomain& domain, Vec2 ab) {
   const double len = length(n);
   out.normal = len > 0 ? n / len : Vec3{0, 0, 1};
   return out;
+}
+
+// The same at the domain's (a, b), towards the domain's centre.
+Sample evaluateSample(const PatchSet& set, const PatchDomain& domain, Vec2 ab) {
+  const Vec2 centre = domain.toPatch(domain.triangle ? Vec2{1.0 / 3, 1.0 / 3} : Vec2{0.5, 0.5});
+  return evaluateAt(set, VertexSource{domain.patch, domain.toPatch(ab), centre});
 }
 
 // One piece of a domain edge between two welded vertices, in the domain's coordinates.
@@ -371,6 +378,7 @@ class Tessellator {
   int addVertex(const Sample& s) {
     positions_.push_back(s.position);
     normals_.push_back(s.normal);
+    sources_.push_back(s.source);
     return static_cast<int>(positions_.size()) - 1;
   }
 
@@ -633,6 +641,7 @@ class Tessellator {
       mesh.positions.emplace_back(positions_[i]);
       mesh.normals.emplace_back(normals_[i]);
     }
+    out.vertexSources = std::move(sources_);
     out.stats = finalStats();
     return out;
   }
@@ -642,6 +651,7 @@ class Tessellator {
   const TessellationOptions& options_;
   const CancelToken& cancel_;
   std::vector<Vec3> positions_, normals_;
+  std::vector<VertexSource> sources_;
   Welder welder_;
   std::vector<uint8_t> patchCulled_;
   std::vector<PatchDomain> domains_;                       // the drawn patches, whole or cut
@@ -662,6 +672,7 @@ bool outsideTheView(const PatchSet& set, const Patch& patch, const Camera& camer
   for (const Vec3& q : points) centre += q / static_cast<double>(points.size());
   double radius = 0;
   for (const Vec3& q : points) radius = std::max(radius, length(q - centre));
+  radius += set.displacementReach();  // displaced points may lie that far off the hull
   // The sphere in camera space against the four side planes (and, in perspective, the eye
   // plane): outside one of them entirely is outside the view.
   const Vec3 d = centre - camera.eye();
@@ -755,6 +766,22 @@ PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
                             const TessellationOptions& options, const CancelToken& cancel) {
   return withinBudget(patches, camera, options, cancel,
                       [](Tessellator& tessellator) { return tessellator.run(); });
+}
+
+void reevaluatePatchMesh(const PatchSet& patches, PatchMesh& mesh, const CancelToken& cancel) {
+  const std::vector<VertexSource>& sources = mesh.vertexSources;
+  if (sources.size() != mesh.mesh.positions.size()) {
+    throw std::logic_error("reevaluatePatchMesh: a mesh without its vertex sources");
+  }
+  parallelFor(sources.size(), 1024, [&](size_t begin, size_t end) {
+    cancel.check();
+    for (size_t i = begin; i < end; ++i) {
+      const Sample s = evaluateAt(patches, sources[i]);
+      mesh.mesh.positions[i] = Vec3f(s.position);
+      mesh.mesh.normals[i] = Vec3f(s.normal);
+    }
+  });
+  cancel.check();
 }
 
 TessellationPlan planPatchTessellation(const PatchSet& patches, const Camera& camera,

@@ -77,9 +77,17 @@ struct TessellationPlan {
   TessellationStats stats;
 };
 
+// Where a vertex was evaluated: patch-local (s, t), and the point its normal is taken towards
+// where the derivatives vanish (its domain's centre).
+struct VertexSource {
+  int32_t patch = 0;
+  Vec2 st, towards;
+};
+
 struct PatchMesh {
   tessellate::TriangleMesh mesh;       // with triangleFaces and cornerUVs (Bfr's, per base face)
   std::vector<int32_t> trianglePatch;  // index into PatchSet::patches(), per triangle
+  std::vector<VertexSource> vertexSources;  // per vertex
   TessellationStats stats;
 };
 
@@ -87,6 +95,12 @@ struct PatchMesh {
 // when the factors would make more than maxTriangles (unless fitToBudget), and Cancelled.
 PatchMesh tessellatePatches(const PatchSet& patches, const Camera& camera,
                             const TessellationOptions& options, const CancelToken& cancel);
+
+// `mesh` (made by tessellatePatches) moved onto the patches' current control points, for an
+// animation frame: every vertex re-evaluated where it was made, in parallel; triangles, factors
+// and the patches left out are kept, so its dicing rate holds only as far as the points move.
+// Checks `cancel`.
+void reevaluatePatchMesh(const PatchSet& patches, PatchMesh& mesh, const CancelToken& cancel);
 
 // The factors tessellatePatches() uses, without evaluating the inside of any patch (the GPU
 // path dices them in tessellation shaders). Same errors and budget fitting.

@@ -54,6 +54,8 @@ void checkCompare(const CompareJob& job, const JobLimits& limits) {
                    "to compare with it");
     }
     within(prefix, [&] { checkMethod(choiceOf(job, m), limits); });
+    checkDisplacement(job.displacement, job.methods[m].method, job.methods[m].params,
+                      prefix + ".method");
   }
   for (size_t c = 0; c < job.cameras.size(); ++c) {
     within("cameras[" + std::to_string(c) + "]", [&] {
@@ -132,7 +134,7 @@ CompareResult compare(const CompareJob& job, const JobLimits& limits, RenderCont
   checkCompare(job, limits);
   mesh::validateMesh(job.mesh, limits.mesh);
   cancel.check();
-  const subdiv::LimitSurface surface(job.mesh, cancel);
+  const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
   CompareResult result;
   result.surfaceMs = clock.lapMs();
   result.controlVertices = job.mesh.vertexCount();

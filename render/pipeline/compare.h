@@ -39,7 +39,8 @@ struct CompareMethod {
 
 struct CompareJob {
   mesh::ControlMesh mesh;
-  std::vector<CameraSpec> cameras;  // at least one
+  subdiv::DisplacementSpec displacement;  // as RenderJob's: every method must draw it
+  std::vector<CameraSpec> cameras;        // at least one
   std::vector<CompareMethod> methods;
   int metricSupersample = 4;
   Outputs outputs{.color = false};  // images of every row and reference (none by default)

@@ -128,14 +128,15 @@ patches::PatchMesh dicePatches(const patches::PatchSet& set, patches::Tessellati
 
 }  // namespace
 
-void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
-                        const JobLimits& limits, const Camera& camera, RenderContext* context,
-                        const CancelToken& cancel, Approximated& out) {
+patches::PatchMesh tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
+                                      const JobLimits& limits, const Camera& camera,
+                                      RenderContext* context, const CancelToken& cancel,
+                                      Approximated& out, bool keepHidden) {
   Stopwatch clock;
   Stats::Patches stats{.table = set.stats(), .tessellation = {}, .tableMs = set.stats().buildMs};
   patches::TessellationOptions options;
   options.dicingRate = choice.params.dicingRate;
-  options.cullHidden = choice.params.cullPatches;
+  options.cullHidden = choice.params.cullPatches && !keepHidden;
   options.maxTriangles = limits.maxTriangles;
   // At 1 px and 1024^2 a coarse Loop mesh would ask for 10M+ triangles (adaptive caps its
   // faces' edges at 128 segments instead): the rate is coarsened to fit, and said.
@@ -156,9 +157,14 @@ void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice
                            std::to_string(options.maxEdgeFactor) +
                            " segments even after cutting their patches into domains");
   }
+  out.stats.patchTable = stats;
+  return tessellation;
+}
+
+void drawPatchMesh(patches::PatchMesh tessellation, const patches::PatchSet& set,
+                   const MethodChoice& choice, Approximated& out) {
   if (choice.outputs.patches) out.patchImageMesh = patches::patchColoredMesh(tessellation, set);
   out.stats.patches = set.stats().patches;
-  out.stats.patchTable = stats;
   out.mesh = std::move(tessellation.mesh);
 }
 
@@ -166,10 +172,12 @@ namespace {
 
 // The patches method: Far's feature-adaptive patch table, tessellated for the camera.
 void approximateWithPatches(const MethodChoice& choice, const JobLimits& limits,
-                            const Camera& camera, RenderContext* context, const CancelToken& cancel,
-                            Approximated& out) {
-  const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel);
-  tessellatePatchSet(set, choice, limits, camera, context, cancel, out);
+                            const subdiv::LimitSurface& surface, const Camera& camera,
+                            RenderContext* context, const CancelToken& cancel, Approximated& out) {
+  const patches::PatchSet set(choice.mesh, choice.params.isolation, cancel,
+                              surface.displacementSpec());
+  drawPatchMesh(tessellatePatchSet(set, choice, limits, camera, context, cancel, out), set, choice,
+                out);
 }
 
 }  // namespace
@@ -193,7 +201,7 @@ Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limi
     }
     out.mesh = std::move(build.built.mesh);
   } else if (choice.method == Method::Patches) {
-    approximateWithPatches(choice, limits, camera, context, cancel, out);
+    approximateWithPatches(choice, limits, surface, camera, context, cancel, out);
   } else {
     out.mesh = tessellateMethod(choice, limits, surface, camera, cancel);
   }

@@ -60,11 +60,15 @@ Approximated approximateMethod(const MethodChoice& choice, const JobLimits& limi
                                RenderContext* context, const CancelToken& cancel);
 
 // The patches method on a patch table already built (animation frames reuse one): its
-// tessellation for `camera` (by the CPU, or by `context`'s GPU tessellator), stats and, with
-// outputs.patches, the patch image's mesh.
-void tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
-                        const JobLimits& limits, const Camera& camera, RenderContext* context,
-                        const CancelToken& cancel, Approximated& out);
+// tessellation for `camera` (by the CPU, or by `context`'s GPU tessellator), with its stats
+// and warnings in `out`. `keepHidden`: no patch culled (a tessellation later frames reuse).
+patches::PatchMesh tessellatePatchSet(const patches::PatchSet& set, const MethodChoice& choice,
+                                      const JobLimits& limits, const Camera& camera,
+                                      RenderContext* context, const CancelToken& cancel,
+                                      Approximated& out, bool keepHidden = false);
+// A patch tessellation as the method's mesh and, with outputs.patches, the patch image's mesh.
+void drawPatchMesh(patches::PatchMesh tessellation, const patches::PatchSet& set,
+                   const MethodChoice& choice, Approximated& out);
 
 // An approximation and its raster passes.
 struct MethodDrawing {

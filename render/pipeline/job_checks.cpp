@@ -1,5 +1,6 @@
 #include "render/pipeline/job_checks.h"
 
+#include <cmath>
 #include <optional>
 
 #include "render/core/error.h"
@@ -16,6 +17,32 @@ void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& l
   }
   if (curveSamples < 0 || curveSamples > limits.maxCurveSamples) {
     badParameter("params.curveSamples", "must be in 0.." + std::to_string(limits.maxCurveSamples));
+  }
+}
+
+void checkDisplacement(const subdiv::DisplacementSpec& displacement, Method method,
+                       const MethodParams& params, const std::string& methodField) {
+  if (!displacement.enabled()) return;
+  if (!std::isfinite(displacement.amplitude) ||
+      std::fabs(displacement.amplitude) > subdiv::kMaxDisplacementAmplitude) {
+    badParameter("displacement.amplitude", "must be within +-" +
+                                               std::to_string(subdiv::kMaxDisplacementAmplitude) +
+                                               " (a fraction of the mesh's bounding-box diagonal)");
+  }
+  if (!(displacement.frequency > 0) || displacement.frequency > subdiv::kMaxDisplacementFrequency) {
+    badParameter("displacement.frequency", "must be in (0, " +
+                                               std::to_string(subdiv::kMaxDisplacementFrequency) +
+                                               "] (waves along the mesh's bounding-box diagonal)");
+  }
+  if (method != Method::Adaptive && method != Method::Patches && method != Method::Limit) {
+    badParameter(methodField, std::string("\"") + methodName(method) +
+                                  "\" does not draw a displacement; the displaced surface is "
+                                  "drawn by \"patches\" and \"adaptive\" (and ray-cast by "
+                                  "\"limit\")");
+  }
+  if (method == Method::Patches && params.tessellator == PatchTessellator::Gpu) {
+    badParameter("params.tessellator",
+                 "\"gpu\" does not displace yet: a displacement is diced by \"cpu\"");
   }
 }
 

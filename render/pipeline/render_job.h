@@ -22,6 +22,7 @@
 #include "render/patches/patch_tessellation.h"
 #include "render/silhouette/presubdivide.h"
 #include "render/silhouette/silhouette_mesh.h"
+#include "render/subdiv/displacement.h"
 
 namespace limn::render::raster {
 class Rasterizer;
@@ -50,6 +51,9 @@ struct MethodParams {
   // patches: who dices the patches, the CPU (welded, shared edge vertices) or the GPU's
   // tessellation stages (the same factors; llvmpipe where there is no GPU).
   PatchTessellator tessellator = PatchTessellator::Cpu;
+  // patches with frames: dice every frame anew (its own factors and culling) rather than
+  // re-evaluate the first frame's tessellation at each frame's points.
+  bool retessellateFrames = false;
   int metricSupersample = 4;  // S for the silhouette metrics
   // Also ray-cast Embree's own subdivision geometry and report its agreement with the reference
   // (Catmull-Clark only; costs about as much as the reference itself).
@@ -99,6 +103,9 @@ struct JobLimits {
 
 struct RenderJob {
   mesh::ControlMesh mesh;
+  // Moves the limit surface along its normals (the reference's too); methods adaptive and
+  // patches draw it, limit ray-casts it.
+  subdiv::DisplacementSpec displacement;
   CameraSpec camera;
   Method method = Method::Adaptive;
   MethodParams params;

@@ -17,6 +17,7 @@ namespace {
 
 void checkJob(const RenderJob& job, const JobLimits& limits) {
   checkMethod({job.mesh, job.method, job.params, job.shading, job.outputs}, limits);
+  checkDisplacement(job.displacement, job.method, job.params, "method");
   checkImageSides(job.camera, limits);
   if (job.reference && job.method != Method::Limit) {
     checkSupersampledMasks(job.camera, job.params.metricSupersample, limits);
@@ -70,7 +71,7 @@ Approximation approximate(const RenderJob& job, const JobLimits& limits,
   checkJob(job, limits);
   mesh::validateMesh(job.mesh, limits.mesh);
   cancel.check();
-  const subdiv::LimitSurface surface(job.mesh, cancel);
+  const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
   Approximation out{.mesh = {},
                     .camera = resolveCamera(job.camera, surface.bounds()),
                     .stats = {},
@@ -122,7 +123,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   cancel.check();
   if (!job.frames.empty()) return runFrames(job, limits, context, cancel);
 
-  const subdiv::LimitSurface surface(job.mesh, cancel);
+  const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
   Camera camera = resolveCamera(job.camera, surface.bounds());
   RenderResult result{.images = {},
                       .referenceImages = {},

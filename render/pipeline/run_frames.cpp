@@ -1,7 +1,12 @@
 // runFrames(): one request, many animation frames of one topology (method patches). The
 // topology, adaptive refinement, patch table and point stencils are built once from the
-// request's mesh; each frame only re-evaluates the points (PatchSet::setControlPoints), then
-// tessellates and rasterises for the same camera, which frames the request's mesh.
+// request's mesh; each frame only re-evaluates the points (PatchSet::setControlPoints). The
+// first frame is tessellated with no patch culled (a later frame may turn it into view); later
+// frames re-evaluate that tessellation's vertices where they were made
+// (patches::reevaluatePatchMesh) unless params.retessellateFrames asks for each frame's own
+// factors, or the GPU tessellator dices each frame. Every frame is rasterised for the same
+// camera, which frames the request's mesh.
+#include <optional>
 #include <string>
 
 #include "render/core/error.h"
@@ -55,7 +60,7 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
                        const CancelToken& cancel) {
   Stopwatch clock, total;
   checkFrames(job, limits);
-  const subdiv::LimitSurface surface(job.mesh, cancel);
+  const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
   RenderResult result{.images = {},
                       .referenceImages = {},
                       .metrics = {},
@@ -68,10 +73,13 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
   result.stats.controlFaces = job.mesh.faceCount();
   result.timings.surfaceMs = clock.lapMs();
 
-  patches::PatchSet set(job.mesh, job.params.isolation, cancel);
+  patches::PatchSet set(job.mesh, job.params.isolation, cancel, job.displacement);
   Outputs outputs = job.outputs;
   outputs.cage = false;  // drawn below with each frame's own points
   mesh::ControlMesh frameMesh = job.mesh;
+  const bool reuse =
+      !job.params.retessellateFrames && job.params.tessellator == PatchTessellator::Cpu;
+  std::optional<patches::PatchMesh> first;  // the first frame's tessellation, when reused
   for (size_t f = 0; f < job.frames.size(); ++f) {
     cancel.check();
     Stopwatch frameClock;
@@ -79,7 +87,15 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
     frameMesh.points = job.frames[f];
     const MethodChoice choice{frameMesh, job.method, job.params, job.shading, outputs};
     Approximated approx;
-    tessellatePatchSet(set, choice, limits, result.camera, &context, cancel, approx);
+    if (first) {
+      patches::reevaluatePatchMesh(set, *first, cancel);
+      drawPatchMesh(*first, set, choice, approx);
+    } else {
+      patches::PatchMesh mesh = tessellatePatchSet(set, choice, limits, result.camera, &context,
+                                                   cancel, approx, /*keepHidden=*/reuse);
+      if (reuse) first = mesh;
+      drawPatchMesh(std::move(mesh), set, choice, approx);
+    }
     if (job.outputs.cage)
       approx.overlays.push_back(tessellate::cageOverlay(frameMesh, pass::kCage));
     approx.stats.triangles = approx.mesh.triangleCount();

@@ -106,9 +106,7 @@ bool FarPatchSurface::covers(int face, const Bfr::Parameterization& param) const
   return true;
 }
 
-void FarPatchSurface::evaluate(int face, const Bfr::Parameterization& param, double u, double v,
-                               Vec3& position, Vec3& du, Vec3& dv) const {
-  PtexPoint at = toPtex(face, param, u, v);
+const Far::PatchMap::Handle& FarPatchSurface::patchAt(int face, const PtexPoint& at) const {
   // The patch map wants coordinates inside the face; a point a little outside (callers allow a
   // small slack) is evaluated on the nearest patch, extended.
   const Far::PatchMap::Handle* handle =
@@ -116,9 +114,16 @@ void FarPatchSurface::evaluate(int face, const Bfr::Parameterization& param, dou
   if (!handle) {
     throw std::logic_error("face " + std::to_string(face) + " has no Far patch");
   }
+  return *handle;
+}
+
+void FarPatchSurface::evaluate(int face, const Bfr::Parameterization& param, double u, double v,
+                               Vec3& position, Vec3& du, Vec3& dv) const {
+  const PtexPoint at = toPtex(face, param, u, v);
+  const Far::PatchMap::Handle& handle = patchAt(face, at);
   std::array<double, kMaxPatchPoints> w, wDs, wDt;
-  patches_->EvaluateBasis(*handle, at.s, at.t, w.data(), wDs.data(), wDt.data());
-  Far::ConstIndexArray cvs = patches_->GetPatchVertices(*handle);
+  patches_->EvaluateBasis(handle, at.s, at.t, w.data(), wDs.data(), wDt.data());
+  Far::ConstIndexArray cvs = patches_->GetPatchVertices(handle);
   position = du = dv = Vec3{0, 0, 0};
   for (int i = 0; i < cvs.size(); ++i) {
     const Vec3& p = patchPoints_[cvs[i]];
@@ -126,6 +131,51 @@ void FarPatchSurface::evaluate(int face, const Bfr::Parameterization& param, dou
     du += p * wDs[i];
     dv += p * wDt[i];
   }
+}
+
+SurfaceJet FarPatchSurface::evaluateJet(int face, const Bfr::Parameterization& param, double u,
+                                        double v) const {
+  const PtexPoint at = toPtex(face, param, u, v);
+  return evaluateFarJet(*patches_, patchAt(face, at), at.s, at.t, patchPoints_);
+}
+
+SurfaceJet evaluateFarJet(const Far::PatchTable& table, const Far::PatchTable::PatchHandle& handle,
+                          double s, double t, const std::vector<Vec3>& points) {
+  std::array<double, kMaxPatchPoints> w, wDs, wDt, wDss, wDst, wDtt;
+  table.EvaluateBasis(handle, s, t, w.data(), wDs.data(), wDt.data(), wDss.data(), wDst.data(),
+                      wDtt.data());
+  const Far::ConstIndexArray cvs = table.GetPatchVertices(handle);
+  SurfaceJet jet{};
+  for (int i = 0; i < cvs.size(); ++i) {
+    const Vec3& p = points[cvs[i]];
+    jet.position += p * w[i];
+    jet.du += p * wDs[i];
+    jet.dv += p * wDt[i];
+    jet.duu += p * wDss[i];
+    jet.duv += p * wDst[i];
+    jet.dvv += p * wDtt[i];
+  }
+  // Where Far's own second derivatives are not the patch's (displacement.h).
+  const Far::PatchDescriptor::Type type =
+      table.GetPatchArrayDescriptor(handle.arrayIndex).GetType();
+  if (type == Far::PatchDescriptor::GREGORY || type == Far::PatchDescriptor::GREGORY_BASIS ||
+      type == Far::PatchDescriptor::GREGORY_TRIANGLE) {
+    differenceSecondDerivatives(jet, s, t, [&](double a, double b, Vec3& da, Vec3& db) {
+      table.EvaluateBasis(handle, a, b, w.data(), wDs.data(), wDt.data());
+      da = db = Vec3{0, 0, 0};
+      for (int i = 0; i < cvs.size(); ++i) {
+        da += points[cvs[i]] * wDs[i];
+        db += points[cvs[i]] * wDt[i];
+      }
+    });
+  } else if (type == Far::PatchDescriptor::LOOP &&
+             table.GetPatchParam(handle).IsTriangleRotated()) {
+    // (The bit means nothing for quads.)
+    jet.duu = -jet.duu;
+    jet.duv = -jet.duv;
+    jet.dvv = -jet.dvv;
+  }
+  return jet;
 }
 
 }  // namespace limn::render::subdiv

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "render/core/vec.h"
+#include "render/subdiv/displacement.h"
 
 namespace limn::render::subdiv {
 
@@ -28,6 +29,13 @@ namespace limn::render::subdiv {
 // at `isolation`: infinitely sharp features as patches, Gregory bases for what stays irregular,
 // smooth corners kept smooth rather than Far's legacy sharp patches, double precision.
 OpenSubdiv::Far::PatchTableFactory::Options bfrPatchOptions(int isolation);
+
+// Position with first and second derivatives of one patch of `table` at its Ptex face's (s, t),
+// the patch's points in `points`; with the second derivatives Far gets wrong (Gregory end caps,
+// rotated Loop sub-triangles) made right as displacement.h says.
+SurfaceJet evaluateFarJet(const OpenSubdiv::Far::PatchTable& table,
+                          const OpenSubdiv::Far::PatchTable::PatchHandle& handle, double s,
+                          double t, const std::vector<Vec3>& points);
 
 class FarPatchSurface {
  public:
@@ -47,6 +55,9 @@ class FarPatchSurface {
   // Limit position and first derivatives at Bfr's (u, v) of `face`. Const and thread-safe.
   void evaluate(int face, const OpenSubdiv::Bfr::Parameterization& param, double u, double v,
                 Vec3& position, Vec3& du, Vec3& dv) const;
+  // The same with second derivatives (for displacement's Weingarten normals).
+  SurfaceJet evaluateJet(int face, const OpenSubdiv::Bfr::Parameterization& param, double u,
+                         double v) const;
 
  private:
   struct PtexPoint {
@@ -55,6 +66,7 @@ class FarPatchSurface {
   };
   PtexPoint toPtex(int face, const OpenSubdiv::Bfr::Parameterization& param, double u,
                    double v) const;
+  const OpenSubdiv::Far::PatchMap::Handle& patchAt(int face, const PtexPoint& at) const;
 
   std::unique_ptr<OpenSubdiv::Far::PatchTable> patches_;
   std::unique_ptr<OpenSubdiv::Far::PatchMap> patchMap_;

@@ -125,7 +125,20 @@ LimitSurface::LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoO
 }
 
 LimitSurface::LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel)
-    : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(createTopologyRefiner(mesh_)) {
+    : LimitSurface(std::move(mesh), cancel, DisplacementSpec{}) {}
+
+LimitSurface::LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel,
+                           const DisplacementSpec& displacement)
+    : mesh_(std::move(mesh)),
+      bounds_(mesh_.bounds()),
+      displacementSpec_(displacement),
+      displacement_(displacement, bounds_),
+      refiner_(createTopologyRefiner(mesh_)) {
+  const double reach = displacement_.reach();
+  if (reach > 0 && !bounds_.empty()) {
+    bounds_.extend(bounds_.lo - Vec3{reach, reach, reach});
+    bounds_.extend(bounds_.hi + Vec3{reach, reach, reach});
+  }
   build({}, cancel);
 }
 
@@ -219,7 +232,7 @@ Vec2 LimitSurface::centerUV(int face) const {
   return {uv[0], uv[1]};
 }
 
-void LimitSurface::evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du,
+void LimitSurface::evaluateUndisplaced(int face, double u, double v, Vec3& position, Vec3& du,
                                        Vec3& dv) const {
   if (faces_[face].onFarPatches) {
     farPatches_->evaluate(face, parameterization(face), u, v, position, du, dv);
@@ -233,6 +246,46 @@ void LimitSurface::evaluateDerivatives(int face, double u, double v, Vec3& posit
   position = {p[0], p[1], p[2]};
   du = {dpu[0], dpu[1], dpu[2]};
   dv = {dpv[0], dpv[1], dpv[2]};
+}
+
+SurfaceJet LimitSurface::evaluateJet(int face, double u, double v) const {
+  if (faces_[face].onFarPatches)
+    return farPatches_->evaluateJet(face, parameterization(face), u, v);
+  const FaceSurface& fs = surfaces_[faces_[face].surfaceIndex];
+  const Bfr::Surface<double>::PointDescriptor xyz(3);
+  double uv[2] = {u, v};
+  double p[3], du[3], dv[3], duu[3], duv[3], dvv[3];
+  fs.surface.Evaluate(uv, fs.patchPoints.data(), xyz, p, du, dv, duu, duv, dvv);
+  auto vec = [](const double* a) { return Vec3{a[0], a[1], a[2]}; };
+  SurfaceJet jet{vec(p), vec(du), vec(dv), vec(duu), vec(duv), vec(dvv)};
+  if (!fs.surface.IsRegular()) {  // displacement.h: Bfr's irregular patch trees
+    differenceSecondDerivatives(jet, u, v, [&](double a, double b, Vec3& da, Vec3& db) {
+      double at[2] = {a, b}, q[3], qa[3], qb[3];
+      fs.surface.Evaluate(at, fs.patchPoints.data(), xyz, q, qa, qb);
+      da = vec(qa);
+      db = vec(qb);
+    });
+  }
+  return jet;
+}
+
+void LimitSurface::evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du,
+                                       Vec3& dv) const {
+  if (!displacement_.enabled()) {
+    evaluateUndisplaced(face, u, v, position, du, dv);
+    return;
+  }
+  const SurfaceJet jet = evaluateJet(face, u, v);
+  if (displace(displacement_, jet, position, du, dv)) return;
+  // The undisplaced normal is undefined here (a corner of some irregular patches): the normal
+  // and its derivatives are their limits from a point nudged towards the centre.
+  const Vec2 c = centerUV(face);
+  SurfaceJet near = evaluateJet(face, u + (c.x - u) * 1e-5, v + (c.y - v) * 1e-5);
+  near.position = jet.position;
+  if (displace(displacement_, near, position, du, dv)) return;
+  position = jet.position;
+  du = jet.du;
+  dv = jet.dv;
 }
 
 LimitSample LimitSurface::evaluate(int face, double u, double v) const {
@@ -253,7 +306,7 @@ LimitSample LimitSurface::evaluate(int face, double u, double v) const {
 }
 
 Vec3 LimitSurface::position(int face, double u, double v) const {
-  if (faces_[face].onFarPatches) {
+  if (faces_[face].onFarPatches || displacement_.enabled()) {
     Vec3 p, du, dv;
     evaluateDerivatives(face, u, v, p, du, dv);
     return p;

@@ -24,6 +24,7 @@
 #include "render/core/cancel.h"
 #include "render/core/vec.h"
 #include "render/mesh/control_mesh.h"
+#include "render/subdiv/displacement.h"
 
 namespace limn::render::subdiv {
 
@@ -55,6 +56,10 @@ class LimitSurface {
   // few faces; a face around a vertex of valence n costs about n^2), and Cancelled thrown when
   // it expires.
   LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel);
+  // The limit surface displaced along its normals (displacement.h): every evaluation below,
+  // bounds() and the control limits are then of the displaced surface.
+  LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel,
+               const DisplacementSpec& displacement);
   ~LimitSurface();
   LimitSurface(const LimitSurface&) = delete;
   LimitSurface& operator=(const LimitSurface&) = delete;
@@ -62,7 +67,11 @@ class LimitSurface {
   // ---- The control mesh ----
   const mesh::ControlMesh& mesh() const { return mesh_; }
   int faceCount() const { return mesh_.faceCount(); }
+  // The control points' bounds (which hold the limit surface), widened by the displacement's
+  // reach.
   Bounds bounds() const { return bounds_; }
+  const DisplacementSpec& displacementSpec() const { return displacementSpec_; }
+  bool displaced() const { return displacement_.enabled(); }
   // A new refiner for the same topology (uniform refinement mutates its refiner, so each
   // caller gets its own).
   std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> createRefiner() const;
@@ -96,9 +105,13 @@ class LimitSurface {
   void buildFaceSurfaces(const std::vector<int>& farPatchFaces, const CancelToken& cancel);
   void computeControlLimits(const CancelToken& cancel);
   void evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du, Vec3& dv) const;
+  void evaluateUndisplaced(int face, double u, double v, Vec3& position, Vec3& du, Vec3& dv) const;
+  SurfaceJet evaluateJet(int face, double u, double v) const;
 
   mesh::ControlMesh mesh_;
   Bounds bounds_;
+  DisplacementSpec displacementSpec_;
+  Displacement displacement_;
   std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> refiner_;
   struct FaceData {
     bool valid = false;

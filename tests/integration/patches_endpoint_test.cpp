@@ -280,14 +280,35 @@ TEST_F(PatchesEndpointTest, ThirtyFramesOfABreathingTorusFromOneTable) {
   EXPECT_GT(covered[7], covered[0] * 1.3);
   EXPECT_LT(covered[22], covered[0] * 0.75);
   EXPECT_NEAR(covered[14], covered[1], covered[0] * 0.05);  // sin(2 pi 14/30) = sin(2 pi/30)
-  // The first frame equals a render of the mesh on its own.
+  // The first frame equals a render of the mesh on its own, with nothing culled (later frames
+  // reuse its tessellation, and may turn any patch into view).
   const std::string single = R"({"mesh": )" + requestMeshJson(torus.mesh) +
                              R"(, "camera": {"eye": [0.5, -4, 3], "width": 128, "height": 128},
-      "method": "patches", "params": {"dicingRate": 4}, "outputs": ["mask"]})";
+      "method": "patches", "params": {"dicingRate": 4, "cullPatches": false},
+      "outputs": ["mask"]})";
   HttpResponse one = post(port(), "/v1/render", single);
   ASSERT_EQ(one.status, 200);
   auto oneDoc = parseJson(one.body);
   EXPECT_EQ(oneDoc["stats"]["triangles"].GetUint64(), doc["frames"][0]["triangles"].GetUint64());
+
+  // Every frame diced anew draws the same picture but for outline pixels; the reused
+  // tessellation keeps the first frame's triangle count.
+  std::string anew = body;
+  anew.replace(anew.find(R"("dicingRate": 4})"), 16,
+               R"("dicingRate": 4, "retessellateFrames": true})");
+  HttpResponse each = post(port(), "/v1/render", anew);
+  ASSERT_EQ(each.status, 200) << each.body.substr(0, 400);
+  auto eachDoc = parseJson(each.body);
+  ASSERT_EQ(eachDoc["frames"].Size(), 30u);
+  for (int f : {0, 7, 22}) {
+    EXPECT_EQ(doc["frames"][f]["triangles"].GetUint64(), doc["frames"][0]["triangles"].GetUint64());
+    const int differ = differingPixels(image(doc["frames"][f]["images"], "mask"),
+                                       image(eachDoc["frames"][f]["images"], "mask"), 0.5f);
+    EXPECT_LE(differ, covered[f] / 100 + 5) << "frame " << f;
+  }
+  EXPECT_NE(eachDoc["frames"][7]["triangles"].GetUint64(),
+            eachDoc["frames"][22]["triangles"].GetUint64())
+      << "diced anew, a larger frame gets more triangles";
 }
 
 TEST_F(PatchesEndpointTest, GpuTessellatorDrawsFramesAndIsNotForDownloads) {
@@ -337,6 +358,93 @@ TEST_F(PatchesEndpointTest, BadFramesNameTheField) {
   for (const Case& c : cases) {
     HttpResponse r = post(port(), "/v1/render", c.body);
     EXPECT_EQ(r.status, c.status) << r.body.substr(0, 300);
+    EXPECT_EQ(errorField(r), c.field) << r.body.substr(0, 300);
+  }
+}
+
+// Analytic displacement: the displaced patches against the displaced reference, within a pixel
+// of its outline; the normals follow the bumps (the colour moves far from the undisplaced
+// picture's and stays near the displaced reference's); adaptive draws the same surface.
+std::string displacedRequest(const NamedMesh& shape, const std::string& method,
+                             const std::string& displacement, const std::string& outputs) {
+  render::subdiv::LimitSurface surface(shape.mesh);
+  RandomView view = randomViews(surface.bounds(), 1, viewSeed(9, shape.name), 320)[0];
+  return R"({"mesh": )" + requestMeshJson(shape.mesh) + R"(, "camera": )" +
+         describeCamera(view.camera) + R"(, "method": ")" + method +
+         R"(", "params": {"dicingRate": 1}, "reference": true, "outputs": )" + outputs +
+         (displacement.empty() ? "" : R"(, "displacement": )" + displacement) + "}";
+}
+
+int coveredPixels(const render::Image& mask) {
+  int covered = 0;
+  for (int y = 0; y < mask.height; ++y) {
+    for (int x = 0; x < mask.width; ++x) covered += mask.at(x, y, 0) > 0.5f;
+  }
+  return covered;
+}
+
+TEST_F(PatchesEndpointTest, DisplacedPatchesMatchTheDisplacedReference) {
+  const char* bumps = R"({"function": "bumps", "amplitude": 0.02, "frequency": 4})";
+  const char* ripples = R"({"function": "ripples", "amplitude": -0.015, "frequency": 3})";
+  for (const NamedMesh& shape : selectShapes(
+           ownShapes(), {"own_cube", "own_icosahedron_loop", "own_torus_40x25", "own_pawn_588"})) {
+    for (const char* displacement : {bumps, ripples}) {
+      HttpResponse r =
+          post(port(), "/v1/render",
+               displacedRequest(shape, "patches", displacement, R"(["color", "mask"])"));
+      ASSERT_EQ(r.status, 200) << shape.name << ": " << r.body.substr(0, 400);
+      auto doc = parseJson(r.body);
+      const double hausdorff = doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble();
+      EXPECT_LE(hausdorff, 1.0) << shape.name << " " << displacement;
+      const render::Image color = image(doc["images"], "color");
+      const int covered = coveredPixels(image(doc["images"], "mask"));
+      const int offReference =
+          differingPixels(color, image(doc["reference"]["images"], "color"), 16.0f / 255);
+
+      HttpResponse plain =
+          post(port(), "/v1/render", displacedRequest(shape, "patches", "", R"(["color"])"));
+      ASSERT_EQ(plain.status, 200);
+      const int moved =
+          differingPixels(color, image(parseJson(plain.body)["images"], "color"), 16.0f / 255);
+      std::printf(
+          "displaced %s %s: %.3f px, colour off the reference in %d, off the "
+          "undisplaced picture in %d of %d covered pixels\n",
+          shape.name.c_str(), displacement, hausdorff, offReference, moved, covered);
+      EXPECT_GT(moved, covered / 5) << shape.name << ": the shading follows the displacement";
+      EXPECT_LT(offReference, covered / 50) << shape.name << ": and matches the reference's";
+    }
+    HttpResponse adaptive =
+        post(port(), "/v1/render", displacedRequest(shape, "adaptive", bumps, R"(["mask"])"));
+    ASSERT_EQ(adaptive.status, 200) << adaptive.body.substr(0, 400);
+    EXPECT_LE(parseJson(adaptive.body)["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 1.0)
+        << shape.name << " adaptive";
+  }
+}
+
+TEST_F(PatchesEndpointTest, BadDisplacementNamesTheField) {
+  const NamedMesh cube = selectShapes(ownShapes(), {"own_cube"})[0];
+  struct Case {
+    std::string method, displacement, params;
+    const char* field;
+  };
+  const std::vector<Case> cases = {
+      {"patches", R"({"function": "noise"})", "{}", "displacement.function"},
+      {"patches", R"({"amplitude": 0.01})", "{}", "displacement.function"},
+      {"patches", R"({"function": "bumps", "amplitude": 0.5})", "{}", "displacement.amplitude"},
+      {"patches", R"({"function": "bumps", "frequency": 0})", "{}", "displacement.frequency"},
+      {"patches", R"({"function": "bumps", "frequency": "high"})", "{}", "displacement.frequency"},
+      {"patches", R"("bumps")", "{}", "displacement"},
+      {"uniform", R"({"function": "bumps"})", "{}", "method"},
+      {"silhouette", R"({"function": "bumps"})", "{}", "method"},
+      {"patches", R"({"function": "bumps"})", R"({"tessellator": "gpu"})", "params.tessellator"},
+  };
+  for (const Case& c : cases) {
+    const std::string body = R"({"mesh": )" + requestMeshJson(cube.mesh) +
+                             R"(, "camera": {"width": 64, "height": 64}, "method": ")" + c.method +
+                             R"(", "params": )" + c.params + R"(, "displacement": )" +
+                             c.displacement + "}";
+    HttpResponse r = post(port(), "/v1/render", body);
+    EXPECT_EQ(r.status, 400) << c.displacement << ": " << r.body.substr(0, 300);
     EXPECT_EQ(errorField(r), c.field) << r.body.substr(0, 300);
   }
 }

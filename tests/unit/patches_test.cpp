@@ -62,6 +62,72 @@ TEST(PatchSet, AgreesWithTheLimitSurface) {
   }
 }
 
+// Displaced, the patches and Bfr still evaluate one surface: positions agree as undisplaced,
+// and the Weingarten normals (from each side's own second derivatives) agree closely.
+TEST(PatchSet, DisplacedPatchesAgreeWithTheDisplacedLimitSurface) {
+  const subdiv::DisplacementSpec bumps{subdiv::DisplacementFunction::Bumps, 0.03, 5};
+  for (auto& [name, m] : closedMeshes()) {
+    const subdiv::LimitSurface surface(m, CancelToken(), bumps);
+    const PatchSet set(m, subdiv::kApproxLevel, CancelToken(), bumps);
+    const double diag = surface.bounds().diagonal();
+    double worst = 0, worstNormal = 0;
+    for (const Patch& patch : set.patches()) {
+      for (Vec2 st : {Vec2{0.25, 0.25}, Vec2{0.5, 0.25}, Vec2{0.25, 0.5}}) {
+        Vec3 p, ds, dt;
+        set.evaluate(patch, st.x, st.y, p, ds, dt);
+        const Vec2 uv = set.toFaceUV(patch, st.x, st.y);
+        const subdiv::LimitSample exact = surface.evaluate(patch.baseFace, uv.x, uv.y);
+        worst = std::max(worst, length(p - exact.position) / diag);
+        worstNormal = std::max(worstNormal, length(normalize(cross(ds, dt)) - exact.normal));
+      }
+    }
+    EXPECT_LT(worst, 1e-9) << name;
+    // (Largest on the 1/64-size Gregory end caps at extraordinary vertices, whose derivatives
+    // are the end cap's: 0.25% there on the pentagonal prism.)
+    EXPECT_LT(worstNormal, 5e-3) << name;
+    // Nothing is culled for facing away: the bumps turn normals out of the patches' cones.
+    for (const Patch& patch : set.patches()) EXPECT_FALSE(patch.cullable) << name;
+  }
+}
+
+// An animation frame on a kept tessellation: the same triangles, every vertex re-evaluated on
+// the new points. Catmull-Clark and Loop limit surfaces move with affine maps of their control
+// points, so doubling the points doubles every vertex and keeps every normal.
+TEST(PatchTessellation, ReevaluatedMeshFollowsNewControlPoints) {
+  for (auto& [name, m] : closedMeshes()) {
+    PatchSet set(m, 4, CancelToken());
+    TessellationOptions options;
+    options.dicingRate = 3;
+    options.cullHidden = false;
+    const Camera camera = viewOf(set, 0, 256);
+    PatchMesh mesh = tessellatePatches(set, camera, options, CancelToken());
+    const PatchMesh original = mesh;
+    ASSERT_EQ(mesh.vertexSources.size(), mesh.mesh.positions.size()) << name;
+    reevaluatePatchMesh(set, mesh, CancelToken());
+    for (size_t i = 0; i < mesh.mesh.positions.size(); ++i) {
+      ASSERT_EQ(mesh.mesh.positions[i].x, original.mesh.positions[i].x) << name;
+    }
+    ControlMesh moved = m;
+    for (Vec3& p : moved.points) p = p * 2.0;
+    set.setControlPoints(moved.points);
+    reevaluatePatchMesh(set, mesh, CancelToken());
+    EXPECT_EQ(mesh.mesh.indices, original.mesh.indices) << name;
+    double worst = 0, worstNormal = 0;
+    for (size_t i = 0; i < mesh.mesh.positions.size(); ++i) {
+      const Vec3 now(mesh.mesh.positions[i].x, mesh.mesh.positions[i].y, mesh.mesh.positions[i].z);
+      const Vec3 before(original.mesh.positions[i].x, original.mesh.positions[i].y,
+                        original.mesh.positions[i].z);
+      worst = std::max(worst, length(now - before * 2.0));
+      const Vec3 n(mesh.mesh.normals[i].x, mesh.mesh.normals[i].y, mesh.mesh.normals[i].z);
+      const Vec3 n0(original.mesh.normals[i].x, original.mesh.normals[i].y,
+                    original.mesh.normals[i].z);
+      worstNormal = std::max(worstNormal, length(n - n0));
+    }
+    EXPECT_LT(worst, 1e-5 * set.controlBounds().diagonal()) << name;
+    EXPECT_LT(worstNormal, 1e-5) << name;
+  }
+}
+
 TEST(PatchSet, CountsGrowWithTheFeaturesNotFourfold) {
   const ControlMesh m = limn::testing::cube();
   std::vector<size_t> counts;
