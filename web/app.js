@@ -118,8 +118,19 @@ function renderBody(mesh, size, compare) {
              polygonizer: { method: $("polygonizer").value, resolution: Number($("resolution").value),
                             flatness: Number($("flatness").value) } };
   }
-  return { mesh, camera: cameraFor(size), method: $("method").value, params: methodParams(),
-           shading: $("shading").value, outputs, reference: compare };
+  const body = { mesh, camera: cameraFor(size), method: $("method").value, params: methodParams(),
+                 shading: $("shading").value, outputs, reference: compare };
+  const displacement = displacementOf(body.method);
+  if (displacement) body.displacement = displacement;
+  return body;
+}
+
+// The displacement the page asks for: drawn by adaptive and patches, ray-cast by limit.
+function displacementOf(method) {
+  const fn = $("displacement").value;
+  if (fn === "none" || !["adaptive", "patches", "limit"].includes(method)) return null;
+  return { function: fn, amplitude: Number($("displacement-amplitude").value),
+           frequency: Number($("displacement-frequency").value) };
 }
 
 // Where the page's renders go: meshes to /v1/render, implicit scenes to /v1/implicit.
@@ -671,7 +682,7 @@ function bindCamera() {
 function showMethodParams() {
   const method = $("method").value;
   for (const group of document.querySelectorAll(".params")) {
-    group.hidden = group.dataset.for !== method;
+    group.hidden = !group.dataset.for.split(" ").includes(method);
   }
 }
 
@@ -700,7 +711,8 @@ function bindControls() {
   $("level").addEventListener("input", () => { $("level-value").textContent = $("level").value; });
   $("method").addEventListener("change", showMethodParams);
   for (const id of ["method", "level", "engine", "dicing-rate", "contour-mode", "presubdivide",
-                    "patch-dicing-rate", "isolation", "show-patches",
+                    "patch-dicing-rate", "isolation", "show-patches", "displacement",
+                    "displacement-amplitude", "displacement-frequency",
                     "draw-surface", "draw-cage", "draw-wireframe", "shading", "size",
                     "polygonizer", "resolution", "flatness"]) {
     $(id).addEventListener("change", renderFull);

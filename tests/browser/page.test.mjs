@@ -387,4 +387,31 @@ describe("limn's page", () => {
     assert.ok(changed > 0.05, `the patch colours changed only ${(100 * changed).toFixed(2)}%`);
     await shot("patches-by-level", page.locator("#view"));
   });
+
+  it("displaces the surface, and the reference with it", async () => {
+    let n = await set("#show-patches", false);
+    await waitForRenders(n + 1);
+    assert.ok(await page.isVisible("#displacement"), "the displacement control is hidden");
+    await keepPixels("#picture", "undisplaced");
+    n = await set("#displacement", "bumps");
+    await waitForRenders(n + 1);
+    await keepPixels("#picture", "bumps");
+    const changed = await differingFraction("undisplaced", "bumps");
+    assert.ok(changed > 0.05, `the bumps changed only ${(100 * changed).toFixed(2)}% of the picture`);
+    // Measured against the displaced reference: still within a pixel.
+    n = await set("#compare", true);
+    await waitForRenders(n + 1);
+    const answer = await page.evaluate(() => window.limnPage.lastAnswer);
+    assert.ok(answer.metrics.silhouette.hausdorffPx <= 1.0,
+              `displaced patches ${answer.metrics.silhouette.hausdorffPx} px off the displaced reference`);
+    await shot("displaced-patches", page.locator("#view"));
+    // A method that does not draw it hides the control and sends none (with it, uniform is a
+    // 400 and no render would count).
+    n = await set("#compare", false);
+    await waitForRenders(n + 1);
+    n = await set("#method", "uniform");
+    await waitForRenders(n + 1);
+    assert.ok(!(await page.isVisible("#displacement")), "the displacement control stayed");
+    await set("#displacement", "none");
+  });
 });
