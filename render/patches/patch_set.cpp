@@ -132,8 +132,9 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
       patch.triangle = triangle;
       patch.inHull = patch.param.GetBoundary() == 0;
       // Displaced, a patch's normals leave the cone of its control points' differences.
-      patch.cullable = descriptor.GetType() == Far::PatchDescriptor::REGULAR && patch.inHull &&
-                       !displacement_.enabled();
+      patch.cullable = (descriptor.GetType() == Far::PatchDescriptor::REGULAR ||
+                        descriptor.GetType() == Far::PatchDescriptor::LOOP) &&
+                       patch.inHull && !displacement_.enabled();
       if (static_cast<int>(stats_.byLevel.size()) <= patch.depth) {
         stats_.byLevel.resize(patch.depth + 1, {});
       }
@@ -236,14 +237,6 @@ Far::ConstIndexArray PatchSet::pointIndices(const Patch& patch) const {
 std::vector<Vec3> PatchSet::controlPoints(const Patch& patch) const {
   std::vector<Vec3> out;
   for (int index : table_->GetPatchVertices(patch.handle)) out.push_back(points_[index]);
-  return out;
-}
-
-std::array<Vec3, 16> PatchSet::bsplinePoints(const Patch& patch) const {
-  Far::ConstIndexArray cvs = table_->GetPatchVertices(patch.handle);
-  if (cvs.size() != 16) throw std::logic_error("not a regular bicubic patch");
-  std::array<Vec3, 16> out;
-  for (int i = 0; i < 16; ++i) out[i] = points_[cvs[i]];
   return out;
 }
 

@@ -48,7 +48,9 @@ struct Patch {
   int depth = 0;     // refinement level of the patch (0: a regular base face)
   PatchKind kind = PatchKind::Regular;
   bool triangle = false;  // Loop: the unit triangle; Catmull-Clark: the unit square
-  bool cullable = false;  // a regular patch without boundary: its 4 x 4 points bound it
+  // A regular B-spline or box-spline patch without boundary, undisplaced: its points bound it
+  // and their differences bound its derivatives (the back-patch cone test).
+  bool cullable = false;
   // Its points are convex combinations of its control points (every patch but those with a
   // boundary edge, whose extrapolated phantom points give some points negative weights).
   bool inHull = false;
@@ -104,8 +106,6 @@ class PatchSet {
   OpenSubdiv::Far::ConstIndexArray pointIndices(const Patch& patch) const;
   // Control, refined and end-cap points, as the patch table indexes them (for the GPU).
   const std::vector<Vec3>& points() const { return points_; }
-  // A regular patch's 4 x 4 B-spline points, row by row (s runs along a row).
-  std::array<Vec3, 16> bsplinePoints(const Patch& patch) const;
 
  private:
   mesh::Scheme scheme_;

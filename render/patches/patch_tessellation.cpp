@@ -691,21 +691,58 @@ bool outsideTheView(const PatchSet& set, const Patch& patch, const Camera& camer
   return beyond(x, tanX) || beyond(y, tanY);
 }
 
+namespace {
+
+// Pairs of a regular patch's points whose differences span its derivatives: a bicubic
+// B-spline's derivative along s is a B-spline over the differences of neighbouring points
+// along s (and likewise t); a quartic box spline's derivative along a lattice direction is a
+// box spline over the differences along that direction. The basis functions are non-negative,
+// so each derivative lies in the cone of its differences. Loop's 12 points (Far's order,
+// checked against the box spline's corner masks in patches_test) lie in rows of 3, 4, 3 and 2
+//     10 11          the patch is the triangle 4 (s, t = 0), 5 (s = 1), 8 (t = 1): s runs
+//    7  8  9         along the rows, t to the upper right.
+//   3  4  5  6
+//    0  1  2
+using PointPairs = std::vector<std::pair<int, int>>;
+const PointPairs kBSplineAlongS = [] {
+  PointPairs out;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 3; ++c) out.push_back({r * 4 + c, r * 4 + c + 1});
+  }
+  return out;
+}();
+const PointPairs kBSplineAlongT = [] {
+  PointPairs out;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 3; ++c) out.push_back({c * 4 + r, (c + 1) * 4 + r});
+  }
+  return out;
+}();
+const PointPairs kBoxSplineAlongS = {{0, 1}, {1, 2}, {3, 4}, {4, 5},
+                                     {5, 6}, {7, 8}, {8, 9}, {10, 11}};
+const PointPairs kBoxSplineAlongT = {{0, 4}, {1, 5}, {2, 6},  {3, 7},
+                                     {4, 8}, {5, 9}, {7, 10}, {8, 11}};
+
+std::vector<Vec3> differences(const std::vector<Vec3>& points, const PointPairs& pairs) {
+  std::vector<Vec3> out;
+  out.reserve(pairs.size());
+  for (auto [from, to] : pairs) out.push_back(points[to] - points[from]);
+  return out;
+}
+
+}  // namespace
+
 bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& camera) {
   if (!patch.cullable) return false;
-  const std::array<Vec3, 16> p = set.bsplinePoints(patch);
-  // The derivatives are convex combinations of the point differences along s and along t, so
-  // the normal ds x dt lies in the cone of their cross products.
-  std::array<Vec3, 12> ds, dt;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      ds[r * 3 + c] = p[r * 4 + c + 1] - p[r * 4 + c];
-      dt[r * 3 + c] = p[(c + 1) * 4 + r] - p[c * 4 + r];
-    }
-  }
+  const std::vector<Vec3> p = set.controlPoints(patch);
+  const bool loop = patch.type == OpenSubdiv::Far::PatchDescriptor::LOOP;
+  // The normal ds x dt lies in the cone of the cross products of the two sets of differences.
+  const std::vector<Vec3> ds = differences(p, loop ? kBoxSplineAlongS : kBSplineAlongS);
+  const std::vector<Vec3> dt = differences(p, loop ? kBoxSplineAlongT : kBSplineAlongT);
   // Which way ds x dt turns relative to the surface normal, read at the centre.
   Vec3 position, centreDs, centreDt;
-  set.evaluate(patch, 0.5, 0.5, position, centreDs, centreDt);
+  const double middle = patch.triangle ? 1.0 / 3.0 : 0.5;
+  set.evaluate(patch, middle, middle, position, centreDs, centreDt);
   const Vec3 centreNormal = cross(centreDs, centreDt);
   Vec3 sum{0, 0, 0};
   for (const Vec3& a : ds) {
@@ -714,7 +751,7 @@ bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& 
   const double orientation = dot(sum, centreNormal) < 0 ? -1.0 : 1.0;
 
   Vec3 centre{0, 0, 0};
-  for (const Vec3& q : p) centre += q / 16.0;
+  for (const Vec3& q : p) centre += q / static_cast<double>(p.size());
   double radius = 0;
   for (const Vec3& q : p) radius = std::max(radius, length(q - centre));
   const bool perspective = camera.projection() == Projection::Perspective;
