@@ -147,7 +147,8 @@ TEST_F(PatchesEndpointTest, CubePatchImageShowsRingsOfLevelsAroundTheCorners) {
 
 TEST_F(PatchesEndpointTest, CullingLeavesTheImageAsItWas) {
   for (const NamedMesh& shape :
-       selectShapes(ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_bumpy_ball_1536"})) {
+       selectShapes(ownShapes(), {"own_cube", "own_torus_12x8_creased", "own_bumpy_ball_1536",
+                                  "own_icosphere_loop_1280"})) {
     std::array<render::Image, 2> pictures;
     std::array<size_t, 2> triangles{};
     for (int cull = 0; cull < 2; ++cull) {
