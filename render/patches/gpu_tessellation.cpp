@@ -113,7 +113,9 @@ float alongSide(int d, int side, float t) {
 
 vec3 point(int i) { return vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]); }
 
-void evaluatePatch(int p, vec2 st, out vec3 position, out vec3 ds, out vec3 dt) {
+// The patch's position and first and second derivatives at its own (s, t).
+void evaluateJet(int p, vec2 st, out vec3 position, out vec3 ds, out vec3 dt, out vec3 dss,
+                 out vec3 dst, out vec3 dtt) {
   float wP[20], wDs[20], wDt[20], wDss[20], wDst[20], wDtt[20];
   OsdPatchParam param = OsdPatchParamInit(patchInfo[4 * p + 2], patchInfo[4 * p + 3], 0.0);
   int n = OsdEvaluatePatchBasisNormalized(patchInfo[4 * p + 1], param, st.x, st.y,
@@ -121,13 +123,92 @@ void evaluatePatch(int p, vec2 st, out vec3 position, out vec3 ds, out vec3 dt) 
   position = vec3(0.0);
   ds = vec3(0.0);
   dt = vec3(0.0);
+  dss = vec3(0.0);
+  dst = vec3(0.0);
+  dtt = vec3(0.0);
   int first = patchInfo[4 * p];
   for (int i = 0; i < n; ++i) {
     vec3 c = point(pointIndices[first + i]);
     position += wP[i] * c;
     ds += wDs[i] * c;
     dt += wDt[i] * c;
+    dss += wDss[i] * c;
+    dst += wDst[i] * c;
+    dtt += wDtt[i] * c;
   }
+}
+
+// Analytic displacement (subdiv/displacement.h): 0 none, 1 bumps, 2 ripples, in world units.
+uniform int displacementFunction;
+uniform float displacementAmplitude;
+uniform float displacementWavenumber;
+uniform vec3 displacementCentre;
+
+float displacementAt(vec3 p, out vec3 gradient) {
+  vec3 q = p - displacementCentre;
+  float a = displacementAmplitude, k = displacementWavenumber;
+  if (displacementFunction == 1) {
+    vec3 s = sin(k * q), c = cos(k * q);
+    gradient = a * k * vec3(c.x * s.y * s.z, s.x * c.y * s.z, s.x * s.y * c.z);
+    return a * s.x * s.y * s.z;
+  }
+  float r = length(q);
+  gradient = r > 0.0 ? q * (a * k * cos(k * r) / r) : vec3(0.0);
+  return a * sin(k * r);
+}
+
+// f = s + N D(s) and its derivatives, N's from the Weingarten equations. The derivatives are
+// the patch-local ones, which Osd's normalized basis gives with the right sign on rotated Loop
+// triangles; a Gregory end cap's second derivatives are differences of its first (as on the
+// CPU: Osd's leave out the rational blending). False where s's normal is undefined.
+bool displace(int p, vec2 st, vec3 s, vec3 su, vec3 sv, vec3 suu, vec3 suv, vec3 svv,
+              out vec3 position, out vec3 du, out vec3 dv) {
+  int type = patchInfo[4 * p + 1];
+  if (type == OSD_PATCH_DESCRIPTOR_GREGORY_BASIS ||
+      type == OSD_PATCH_DESCRIPTOR_GREGORY_TRIANGLE) {
+    const float h = 1e-3;
+    vec3 q, a0, b0, a1, b1, ignored1, ignored2, ignored3;
+    evaluateJet(p, st - vec2(h, 0.0), q, a0, b0, ignored1, ignored2, ignored3);
+    evaluateJet(p, st + vec2(h, 0.0), q, a1, b1, ignored1, ignored2, ignored3);
+    suu = (a1 - a0) / (2.0 * h);
+    vec3 alongS = (b1 - b0) / (2.0 * h);
+    evaluateJet(p, st - vec2(0.0, h), q, a0, b0, ignored1, ignored2, ignored3);
+    evaluateJet(p, st + vec2(0.0, h), q, a1, b1, ignored1, ignored2, ignored3);
+    svv = (b1 - b0) / (2.0 * h);
+    suv = 0.5 * (alongS + (a1 - a0) / (2.0 * h));
+  }
+  vec3 c = cross(su, sv);
+  float area = length(c);
+  if (!(area > 1e-5 * (dot(su, su) + dot(sv, sv)))) return false;
+  vec3 n = c / area;
+  float E = dot(su, su), F = dot(su, sv), G = dot(sv, sv);
+  float e = dot(suu, n), f = dot(suv, n), g = dot(svv, n);
+  float det = E * G - F * F;
+  vec3 nu = (su * (f * F - e * G) + sv * (e * F - f * E)) / det;
+  vec3 nv = (su * (g * F - f * G) + sv * (f * F - g * E)) / det;
+  vec3 gradient;
+  float d = displacementAt(s, gradient);
+  position = s + n * d;
+  du = su + nu * d + n * dot(gradient, su);
+  dv = sv + nv * d + n * dot(gradient, sv);
+  return true;
+}
+
+// Position and first derivatives at the patch's (s, t), displaced when asked (PatchSet's
+// evaluate(): where the normal is undefined, N from a point nudged towards the patch's centre).
+void evaluatePatch(int p, vec2 st, out vec3 position, out vec3 ds, out vec3 dt) {
+  vec3 dss, dst, dtt;
+  evaluateJet(p, st, position, ds, dt, dss, dst, dtt);
+  if (displacementFunction == 0) return;
+  vec3 s = position, su = ds, sv = dt;
+  if (displace(p, st, s, su, sv, dss, dst, dtt, position, ds, dt)) return;
+  float centre = patchInfo[4 * p + 1] == OSD_PATCH_DESCRIPTOR_REGULAR ||
+                 patchInfo[4 * p + 1] == OSD_PATCH_DESCRIPTOR_GREGORY_BASIS ? 0.5 : 1.0 / 3.0;
+  vec2 near = mix(st, vec2(centre), 1e-3);
+  vec3 q;
+  evaluateJet(p, near, q, su, sv, dss, dst, dtt);
+  if (displace(p, near, s, su, sv, dss, dst, dtt, position, ds, dt)) return;
+  position = s;
 }
 
 vec2 toPatch(int d, vec2 ab) {
@@ -424,6 +505,13 @@ PatchMesh GpuPatchTessellator::tessellate(const PatchSet& set, const Tessellatio
   const bool triangle = set.scheme() == mesh::Scheme::Loop;
   const ShaderProgram& program = triangle ? impl_->triangles : impl_->quads;
   program.use();
+  const subdiv::Displacement& displacement = set.displacement();
+  program.setInt("displacementFunction", static_cast<int>(displacement.function()));
+  program.setFloat("displacementAmplitude", static_cast<float>(displacement.amplitude()));
+  program.setFloat("displacementWavenumber", static_cast<float>(displacement.wavenumber()));
+  const Vec3 centre = displacement.centre();
+  program.setVec3("displacementCentre", static_cast<float>(centre.x), static_cast<float>(centre.y),
+                  static_cast<float>(centre.z));
   std::vector<CapturedVertex> captured;
   {
     const DrawState state(impl_->framebuffer, impl_->vertexArray);

@@ -132,9 +132,10 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
       patch.triangle = triangle;
       patch.inHull = patch.param.GetBoundary() == 0;
       // Displaced, a patch's normals leave the cone of its control points' differences.
-      patch.cullable = (descriptor.GetType() == Far::PatchDescriptor::REGULAR ||
-                        descriptor.GetType() == Far::PatchDescriptor::LOOP) &&
-                       patch.inHull && !displacement_.enabled();
+      // (Loop patches are not: the box-spline cone test culled visible patches from some
+      // views through the server; patch_tessellation.cpp keeps it for when that is found.)
+      patch.cullable = descriptor.GetType() == Far::PatchDescriptor::REGULAR && patch.inHull &&
+                       !displacement_.enabled();
       if (static_cast<int>(stats_.byLevel.size()) <= patch.depth) {
         stats_.byLevel.resize(patch.depth + 1, {});
       }

@@ -92,6 +92,7 @@ class PatchSet {
   const Bounds& controlBounds() const { return controlBounds_; }
   // How far displacement may move a point off the patches' hull (0: not displaced).
   double displacementReach() const { return displacement_.reach(); }
+  const subdiv::Displacement& displacement() const { return displacement_; }
 
   // Position and first derivatives at patch-local (s, t): [0,1]^2, or the unit triangle; of the
   // displaced surface when there is a displacement.

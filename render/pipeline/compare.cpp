@@ -54,8 +54,7 @@ void checkCompare(const CompareJob& job, const JobLimits& limits) {
                    "to compare with it");
     }
     within(prefix, [&] { checkMethod(choiceOf(job, m), limits); });
-    checkDisplacement(job.displacement, job.methods[m].method, job.methods[m].params,
-                      prefix + ".method");
+    checkDisplacement(job.displacement, job.methods[m].method, prefix + ".method");
   }
   for (size_t c = 0; c < job.cameras.size(); ++c) {
     within("cameras[" + std::to_string(c) + "]", [&] {

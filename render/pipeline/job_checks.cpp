@@ -21,7 +21,7 @@ void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& l
 }
 
 void checkDisplacement(const subdiv::DisplacementSpec& displacement, Method method,
-                       const MethodParams& params, const std::string& methodField) {
+                       const std::string& methodField) {
   if (!displacement.enabled()) return;
   if (!std::isfinite(displacement.amplitude) ||
       std::fabs(displacement.amplitude) > subdiv::kMaxDisplacementAmplitude) {
@@ -39,10 +39,6 @@ void checkDisplacement(const subdiv::DisplacementSpec& displacement, Method meth
                                   "\" does not draw a displacement; the displaced surface is "
                                   "drawn by \"patches\" and \"adaptive\" (and ray-cast by "
                                   "\"limit\")");
-  }
-  if (method == Method::Patches && params.tessellator == PatchTessellator::Gpu) {
-    badParameter("params.tessellator",
-                 "\"gpu\" does not displace yet: a displacement is diced by \"cpu\"");
   }
 }
 

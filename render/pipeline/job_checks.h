@@ -32,11 +32,11 @@ class Stopwatch {
 // params.searchSteps and params.curveSamples of the silhouette method.
 void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& limits);
 
-// A displacement's function, amplitude and frequency, and that `method` (with `params`) draws
-// it: adaptive and patches evaluate the displaced surface, limit ray-casts it; the others draw
-// the undisplaced control mesh or its refinement. `methodField` names the method in messages.
+// A displacement's function, amplitude and frequency, and that `method` draws it: adaptive and
+// patches evaluate the displaced surface, limit ray-casts it; the others draw the undisplaced
+// control mesh or its refinement. `methodField` names the method in messages.
 void checkDisplacement(const subdiv::DisplacementSpec& displacement, Method method,
-                       const MethodParams& params, const std::string& methodField);
+                       const std::string& methodField);
 
 // camera.width and camera.height against maxImageSide (LimitExceeded).
 void checkImageSides(const CameraSpec& camera, const JobLimits& limits);

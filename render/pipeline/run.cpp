@@ -17,7 +17,7 @@ namespace {
 
 void checkJob(const RenderJob& job, const JobLimits& limits) {
   checkMethod({job.mesh, job.method, job.params, job.shading, job.outputs}, limits);
-  checkDisplacement(job.displacement, job.method, job.params, "method");
+  checkDisplacement(job.displacement, job.method, "method");
   checkImageSides(job.camera, limits);
   if (job.reference && job.method != Method::Limit) {
     checkSupersampledMasks(job.camera, job.params.metricSupersample, limits);

@@ -19,12 +19,13 @@
 
 namespace limn::render::subdiv {
 
+// (The values are the GPU tessellator's: patches/gpu_tessellation.cpp.)
 enum class DisplacementFunction {
-  None,
+  None = 0,
   // D = a sin(k x) sin(k y) sin(k z) about the mesh's centre: a lattice of bumps and dents.
-  Bumps,
+  Bumps = 1,
   // D = a sin(k |p - centre|): concentric waves around the mesh's centre.
-  Ripples,
+  Ripples = 2,
 };
 
 // What a request asks for, in the mesh's own scale: `amplitude` is a fraction of the control
@@ -58,6 +59,11 @@ class Displacement {
   double reach() const { return std::fabs(amplitude_); }
   // D(p) and its gradient.
   double value(const Vec3& p, Vec3* gradient) const;
+  // What value() computes with (the GPU tessellator's uniforms).
+  DisplacementFunction function() const { return function_; }
+  double amplitude() const { return amplitude_; }
+  double wavenumber() const { return wavenumber_; }
+  Vec3 centre() const { return centre_; }
 
  private:
   DisplacementFunction function_ = DisplacementFunction::None;
