@@ -195,16 +195,7 @@ Vec2 PatchSet::toFaceUV(const Patch& patch, double s, double t) const {
 
 void PatchSet::evaluateUndisplaced(const Patch& patch, Vec2 ptex, Vec3& position, Vec3& ds,
                                    Vec3& dt) const {
-  std::array<double, kMaxPatchPoints> w, wDs, wDt;
-  table_->EvaluateBasis(patch.handle, ptex.x, ptex.y, w.data(), wDs.data(), wDt.data());
-  Far::ConstIndexArray cvs = table_->GetPatchVertices(patch.handle);
-  position = ds = dt = Vec3{0, 0, 0};
-  for (int i = 0; i < cvs.size(); ++i) {
-    const Vec3& p = points_[cvs[i]];
-    position += p * w[i];
-    ds += p * wDs[i];
-    dt += p * wDt[i];
-  }
+  subdiv::evaluateFarPoint(*table_, patch.handle, ptex.x, ptex.y, points_, position, ds, dt);
 }
 
 subdiv::SurfaceJet PatchSet::evaluateJet(const Patch& patch, Vec2 ptex) const {

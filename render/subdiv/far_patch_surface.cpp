@@ -120,16 +120,21 @@ const Far::PatchMap::Handle& FarPatchSurface::patchAt(int face, const PtexPoint&
 void FarPatchSurface::evaluate(int face, const Bfr::Parameterization& param, double u, double v,
                                Vec3& position, Vec3& du, Vec3& dv) const {
   const PtexPoint at = toPtex(face, param, u, v);
-  const Far::PatchMap::Handle& handle = patchAt(face, at);
+  evaluateFarPoint(*patches_, patchAt(face, at), at.s, at.t, patchPoints_, position, du, dv);
+}
+
+void evaluateFarPoint(const Far::PatchTable& table, const Far::PatchTable::PatchHandle& handle,
+                      double s, double t, const std::vector<Vec3>& points, Vec3& position, Vec3& ds,
+                      Vec3& dt) {
   std::array<double, kMaxPatchPoints> w, wDs, wDt;
-  patches_->EvaluateBasis(handle, at.s, at.t, w.data(), wDs.data(), wDt.data());
-  Far::ConstIndexArray cvs = patches_->GetPatchVertices(handle);
-  position = du = dv = Vec3{0, 0, 0};
+  table.EvaluateBasis(handle, s, t, w.data(), wDs.data(), wDt.data());
+  const Far::ConstIndexArray cvs = table.GetPatchVertices(handle);
+  position = ds = dt = Vec3{0, 0, 0};
   for (int i = 0; i < cvs.size(); ++i) {
-    const Vec3& p = patchPoints_[cvs[i]];
+    const Vec3& p = points[cvs[i]];
     position += p * w[i];
-    du += p * wDs[i];
-    dv += p * wDt[i];
+    ds += p * wDs[i];
+    dt += p * wDt[i];
   }
 }
 
@@ -161,12 +166,8 @@ SurfaceJet evaluateFarJet(const Far::PatchTable& table, const Far::PatchTable::P
   if (type == Far::PatchDescriptor::GREGORY || type == Far::PatchDescriptor::GREGORY_BASIS ||
       type == Far::PatchDescriptor::GREGORY_TRIANGLE) {
     differenceSecondDerivatives(jet, s, t, [&](double a, double b, Vec3& da, Vec3& db) {
-      table.EvaluateBasis(handle, a, b, w.data(), wDs.data(), wDt.data());
-      da = db = Vec3{0, 0, 0};
-      for (int i = 0; i < cvs.size(); ++i) {
-        da += points[cvs[i]] * wDs[i];
-        db += points[cvs[i]] * wDt[i];
-      }
+      Vec3 ignored;
+      evaluateFarPoint(table, handle, a, b, points, ignored, da, db);
     });
   } else if (type == Far::PatchDescriptor::LOOP &&
              table.GetPatchParam(handle).IsTriangleRotated()) {

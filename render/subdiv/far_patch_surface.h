@@ -30,6 +30,11 @@ namespace limn::render::subdiv {
 // smooth corners kept smooth rather than Far's legacy sharp patches, double precision.
 OpenSubdiv::Far::PatchTableFactory::Options bfrPatchOptions(int isolation);
 
+// Position and first derivatives of one patch of `table` at its Ptex face's (s, t), the
+// patch's points in `points`.
+void evaluateFarPoint(const OpenSubdiv::Far::PatchTable& table,
+                      const OpenSubdiv::Far::PatchTable::PatchHandle& handle, double s, double t,
+                      const std::vector<Vec3>& points, Vec3& position, Vec3& ds, Vec3& dt);
 // Position with first and second derivatives of one patch of `table` at its Ptex face's (s, t),
 // the patch's points in `points`; with the second derivatives Far gets wrong (Gregory end caps,
 // rotated Loop sub-triangles) made right as displacement.h says.
