@@ -26,6 +26,37 @@ double outsidePixels(const Camera& camera, const Vec3& chordPoint,
   return std::hypot(a.x - b.x, a.y - b.y);
 }
 
+void sortByT(std::vector<EdgePoint>& points) {
+  std::sort(points.begin(), points.end(),
+            [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
+}
+
+// The uniform points bring the chord's sag under the tolerance where the edge bends evenly; an
+// edge into an infinitely sharp corner bends most next to it (the spike's cusp), so segments
+// between the points (crossings included) still over the tolerance are halved until they are
+// not, with at most options.maxSegments points on the edge. True when it added any.
+template <typename Evaluate>
+bool halveOutsideSegments(const Camera& camera, const Vec3& first, const Vec3& last,
+                          const Evaluate& at, const ChordOptions& options,
+                          std::vector<EdgePoint>& points) {
+  bool added = false;
+  for (size_t i = 0; i <= points.size();) {
+    if (static_cast<int>(points.size()) >= options.maxSegments) break;
+    const double t0 = i == 0 ? 0.0 : points[i - 1].t;
+    const double t1 = i == points.size() ? 1.0 : points[i].t;
+    const Vec3& p0 = i == 0 ? first : points[i - 1].position;
+    const Vec3& p1 = i == points.size() ? last : points[i].position;
+    const double t = 0.5 * (t0 + t1);
+    const subdiv::LimitSample middle = at(t);
+    if (t1 - t0 < 1e-4 || outsidePixels(camera, 0.5 * (p0 + p1), middle) <= options.tolerancePx) {
+      ++i;
+      continue;
+    }
+    points.insert(points.begin() + static_cast<long>(i), {t, middle.position, 0u});
+    added = true;  // the same i again: the first half of the segment
+  }
+  return added;
+}
 }  // namespace
 
 std::vector<bool> contourFaces(const subdiv::LimitSurface& surface, const ContourSearch& search) {
@@ -86,19 +117,22 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
       }
       if (owner < 0) continue;
       Far::ConstIndexArray ends = base.GetEdgeVertices(static_cast<int>(e));
-      subdiv::LimitSample mid =
-          domains.evaluate(owner, edgeUV(domains, owner, static_cast<int>(e), 0.5));
-      int segments =
-          segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), mid), options);
-      if (segments < 2) continue;
-      out.edgeRates[e] = segments;
-      for (int i = 1; i < segments; ++i) {
-        double t = static_cast<double>(i) / segments;
-        points.push_back(
-            {t, domains.position(owner, edgeUV(domains, owner, static_cast<int>(e), t)), 0u});
+      auto at = [&](double t) {
+        return domains.evaluate(owner, edgeUV(domains, owner, static_cast<int>(e), t));
+      };
+      int segments = segmentsFor(
+          outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), at(0.5)), options);
+      if (segments >= 2) {
+        out.edgeRates[e] = segments;
+        for (int i = 1; i < segments; ++i) {
+          double t = static_cast<double>(i) / segments;
+          points.push_back({t, at(t).position, 0u});
+        }
+        sortByT(points);
       }
-      std::sort(points.begin(), points.end(),
-                [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
+      if (halveOutsideSegments(camera, limit[ends[0]], limit[ends[1]], at, options, points)) {
+        out.edgeRates[e] = std::max(out.edgeRates[e], 2);
+      }
     }
   });
   for (int rate : out.edgeRates) out.refinedEdges += rate > 0;

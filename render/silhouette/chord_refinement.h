@@ -25,7 +25,7 @@ struct ChordOptions {
   // passes close in front of another part (a torus's hole seen nearly closed) the faces two
   // rings out still project next to it.
   int rings = 2;
-  int maxFaceSplits = 64;  // interior edge splits per contour face (face_refinement.h)
+  int maxFaceSplits = 256;  // interior edge splits per face (face_refinement.h)
 };
 
 struct ChordRefinement {

@@ -60,7 +60,29 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
   const size_t originalPoints = points.size();
 
   int splits = 0;
-  std::set<Edge> checked;  // interior edges found fine (their chord is within tolerance)
+  // Each edge's sag is evaluated once: a split only adds edges.
+  struct Sag {
+    double px = 0;  // how far outside, 0 when within tolerance or not to be split
+    FacePoint middle;
+  };
+  std::map<Edge, Sag> sags;
+  auto sagOf = [&](const Edge& e) -> const Sag& {
+    auto found = sags.find(e);
+    if (found != sags.end()) return found->second;
+    Sag out;
+    const Vec2 &ua = points[e.first].uv, &ub = points[e.second].uv;
+    const bool splittable = !locked.count(e) &&
+                            std::hypot(ua.x - ub.x, ua.y - ub.y) >= 1e-6 &&  // not too short
+                            length(points[e.first].position - points[e.second].position) >= 1e-9 &&
+                            // along the domain's boundary a split would put a point on the face's
+                            // boundary that the neighbour does not have
+                            !domains.onOneSide(face, ua, ub);
+    if (splittable) {
+      out.px = sag(e.first, e.second, &out.middle);
+      if (out.px <= tolerancePx) out.px = 0;
+    }
+    return sags.emplace(e, out).first->second;
+  };
   while (splits < maxSplits) {
     // Find the worst interior edge still over tolerance.
     double worst = tolerancePx;
@@ -68,55 +90,54 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
     FacePoint targetMiddle;
     for (const auto& t : triangles) {
       for (int k = 0; k < 3; ++k) {
-        Edge e = key(t[k], t[(k + 1) % 3]);
-        if (locked.count(e) || checked.count(e)) continue;
-        const Vec2 &ua = points[e.first].uv, &ub = points[e.second].uv;
-        if (std::hypot(ua.x - ub.x, ua.y - ub.y) < 1e-6 ||  // too short to split further
-            length(points[e.first].position - points[e.second].position) < 1e-9 ||
-            // along the domain's boundary: a split there would put a point on the face's
-            // boundary that the neighbour does not have
-            domains.onOneSide(face, ua, ub)) {
-          checked.insert(e);
-          continue;
-        }
-        FacePoint middle;
-        double s = sag(e.first, e.second, &middle);
-        if (s > worst) {
-          worst = s;
+        const Edge e = key(t[k], t[(k + 1) % 3]);
+        const Sag& s = sagOf(e);
+        if (s.px > worst) {
+          worst = s.px;
           target = e;
-          targetMiddle = middle;
-        } else if (s <= tolerancePx) {
-          checked.insert(e);
+          targetMiddle = s.middle;
         }
       }
     }
     if (target.first < 0) break;
 
-    // Split it: each triangle (a, b, c) on the edge becomes (a, m, c) and (m, b, c).
+    // Split it: each triangle (a, b, c) on the edge becomes (a, m, c) and (m, b, c), unless a
+    // half would have no area in (u, v) (slivers next to a sharp corner, split many times).
     const int m = static_cast<int>(points.size());
     points.push_back(targetMiddle);
-    const size_t count = triangles.size();
-    for (size_t i = 0; i < count; ++i) {
-      std::array<int, 3> t = triangles[i];
+    std::vector<std::pair<size_t, std::array<int, 3>>> halves;  // (triangle, first half)
+    std::vector<std::array<int, 3>> secondHalves;
+    bool degenerate = false;
+    for (size_t i = 0; i < triangles.size() && !degenerate; ++i) {
+      const std::array<int, 3>& t = triangles[i];
       for (int k = 0; k < 3; ++k) {
         int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
         if (key(a, b) != target) continue;
-        triangles[i] = {a, m, c};
-        triangles.push_back({m, b, c});
+        halves.push_back({i, {a, m, c}});
+        secondHalves.push_back({m, b, c});
+        degenerate = !(uvArea({a, m, c}) > 0) || !(uvArea({m, b, c}) > 0);
         break;
       }
     }
+    if (degenerate) {
+      points.pop_back();
+      sags[target].px = 0;
+      continue;
+    }
+    for (const auto& [at, half] : halves) triangles[at] = half;
+    triangles.insert(triangles.end(), secondHalves.begin(), secondHalves.end());
     ++splits;
   }
   // In 3D, no edge may be shared by more than two triangles (that would be a fold, which the
   // surface pinching near a crease has produced).
   auto folded = [&] {
-    using Key = std::pair<std::array<float, 3>, std::array<float, 3>>;
+    // Positions compared exactly: many splits next to a sharp corner put distinct points within
+    // float rounding of each other, which is no fold.
+    using Key = std::pair<std::array<double, 3>, std::array<double, 3>>;
     std::map<Key, int> uses;
     auto at = [&](int i) {
       const Vec3& p = points[i].position;
-      return std::array<float, 3>{static_cast<float>(p.x), static_cast<float>(p.y),
-                                  static_cast<float>(p.z)};
+      return std::array<double, 3>{p.x, p.y, p.z};
     };
     for (const auto& t : triangles) {
       for (int k = 0; k < 3; ++k) {

@@ -117,7 +117,10 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
   for (int e : surface.baseLevel().GetFaceEdges(face)) {
     sharpSide = sharpSide || surface.baseLevel().GetEdgeSharpness(e) >= mesh::kInfiniteSharpness;
   }
-  if (!paths.empty() && options.curves.mode == CurveMode::Exact && !sharpSide) {
+  // A ring face whose edges carry more than their uniform points (a crossing seen from the
+  // neighbour only) had no Bfr tessellation above; its ear-clipped fan is split the same way.
+  const bool ringFallback = chords.interiorRates[face] >= 2;
+  if ((!paths.empty() || ringFallback) && options.curves.mode == CurveMode::Exact && !sharpSide) {
     std::vector<std::vector<int>> chains;
     for (const CurvePath& path : paths) {
       std::vector<int> chain{path.from};
@@ -145,23 +148,38 @@ bool isClosed(const subdiv::LimitSurface& surface) {
   return true;
 }
 
-// Leaves out the triangles whose three corners face away from the eye (the cosine between the
-// limit normal and the view ray above kBackFacingCos; contour points, at 0, never count). On a
-// closed surface they are hidden, but their flat chords lie on the eye's side of the true
-// surface, so next to an inner contour they could poke through the front's chords, which lie
-// behind it: the dark fringes of back faces along a fold.
+// Leaves out the triangles that face away from the eye: on a closed surface they are hidden,
+// but their flat chords lie on the eye's side of the true surface, so next to an inner contour
+// they could poke through the front's chords, which lie behind it (the dark fringes of back
+// faces along a fold). A corner faces away when the cosine between its limit normal and the view
+// ray is above kBackFacingCos; corners on the contour (cosine about 0) do not say which side a
+// triangle is on, so a triangle with no corner facing the eye is decided by its (u, v) centre.
+// That catches the back region's triangles whose corners all lie on the contour curve: where the
+// outline is concave (the flanks of a sharp corner's spike) their chords span the concavity and
+// stick out past the outline by pixels.
 constexpr double kBackFacingCos = 1e-3;
 
-size_t cullBackFacing(const Camera& camera, FacePiece& piece) {
-  std::vector<bool> back(piece.points.size());
+size_t cullBackFacing(const FaceDomains& domains, const Camera& camera, int face,
+                      FacePiece& piece) {
+  auto facing = [&](const Vec3& position, const Vec3& normal) {
+    const double cosine =
+        contourFunction(camera, position, normal) / length(camera.viewVector(position));
+    return cosine > kBackFacingCos ? 1 : cosine < -kBackFacingCos ? -1 : 0;
+  };
+  std::vector<int> side(piece.points.size());
   for (size_t i = 0; i < piece.points.size(); ++i) {
-    const FacePoint& p = piece.points[i];
-    const Vec3 ray = camera.viewVector(p.position);
-    back[i] = contourFunction(camera, p.position, p.normal) > kBackFacingCos * length(ray);
+    side[i] = facing(piece.points[i].position, piece.points[i].normal);
   }
   const size_t before = piece.triangles.size();
   std::erase_if(piece.triangles, [&](const std::array<int, 3>& t) {
-    return back[t[0]] && back[t[1]] && back[t[2]];
+    if (side[t[0]] < 0 || side[t[1]] < 0 || side[t[2]] < 0) return false;
+    if (side[t[0]] > 0 && side[t[1]] > 0 && side[t[2]] > 0) return true;
+    const Vec2& a = piece.points[t[0]].uv;
+    const Vec2& b = piece.points[t[1]].uv;
+    const Vec2& c = piece.points[t[2]].uv;
+    const subdiv::LimitSample centre =
+        domains.evaluate(face, {(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3});
+    return facing(centre.position, centre.normal) > 0;
   });
   return before - piece.triangles.size();
 }
@@ -187,7 +205,7 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
       if ((f & 63) == 0) cancel.check();
       if (!surface.hasLimit(static_cast<int>(f))) continue;
       pieces[f] = buildFace(domains, camera, out.search, chords, options, static_cast<int>(f));
-      if (cull) pieces[f].culled = cullBackFacing(camera, pieces[f]);
+      if (cull) pieces[f].culled = cullBackFacing(domains, camera, static_cast<int>(f), pieces[f]);
     }
   });
   cancel.check();
