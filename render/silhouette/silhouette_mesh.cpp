@@ -25,7 +25,7 @@ struct FacePiece {
   size_t coarseTriangles = 0, curveSamples = 0, unresolved = 0;
   int splits = 0;
   bool odd = false;
-  size_t culled = 0;  // triangles left out as hidden (cullBackFacing)
+  size_t culled = 0;  // triangles left out as hidden (cullHidden)
 };
 
 // A ring face refined by refineConcaveChords: Bfr's tessellation with the face's edge rates
@@ -110,12 +110,15 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
   piece.triangles = triangulateFace(uv, static_cast<int>(boundary.points.size()), paths);
   // Only exact curves lie on the surface; a chord ending at a pn sample (off the surface) would
   // never come within tolerance, so pn faces keep their ear-clipped triangles.
-  // Faces along an infinitely sharp edge are left as clipped: the surface can pinch there
-  // (two (u, v) points on one position), and splitting towards it folded triangles over each
-  // other in tests.
+  // Faces along an infinitely sharp interior edge are left as clipped: the surface can pinch
+  // there (two (u, v) points on one position), and splitting towards it folded triangles over
+  // each other in tests. Boundary edges (infinitely sharp to Far as well) do not pinch, and the
+  // faces along them need the splits as much as any: a strip seen edge-on bends its outline.
+  const Far::TopologyLevel& base = surface.baseLevel();
   bool sharpSide = false;
-  for (int e : surface.baseLevel().GetFaceEdges(face)) {
-    sharpSide = sharpSide || surface.baseLevel().GetEdgeSharpness(e) >= mesh::kInfiniteSharpness;
+  for (int e : base.GetFaceEdges(face)) {
+    sharpSide = sharpSide ||
+                (!base.IsEdgeBoundary(e) && base.GetEdgeSharpness(e) >= mesh::kInfiniteSharpness);
   }
   // A ring face whose edges carry more than their uniform points (a crossing seen from the
   // neighbour only) had no Bfr tessellation above; its ear-clipped fan is split the same way.
@@ -148,19 +151,21 @@ bool isClosed(const subdiv::LimitSurface& surface) {
   return true;
 }
 
-// Leaves out the triangles that face away from the eye: on a closed surface they are hidden,
-// but their flat chords lie on the eye's side of the true surface, so next to an inner contour
-// they could poke through the front's chords, which lie behind it (the dark fringes of back
-// faces along a fold). A corner faces away when the cosine between its limit normal and the view
-// ray is above kBackFacingCos; corners on the contour (cosine about 0) do not say which side a
-// triangle is on, so a triangle with no corner facing the eye is decided by its (u, v) centre.
-// That catches the back region's triangles whose corners all lie on the contour curve: where the
-// outline is concave (the flanks of a sharp corner's spike) their chords span the concavity and
-// stick out past the outline by pixels.
+// Leaves out triangles that cannot be seen. On a closed surface, every triangle that faces away
+// from the eye: it is hidden there, but its flat chord lies on the eye's side of the true
+// surface, so next to an inner contour it could poke through the front's chords, which lie
+// behind it (the dark fringes of back faces along a fold). A corner faces away when the cosine
+// between its limit normal and the view ray is above kBackFacingCos; corners on the contour
+// (cosine about 0) do not say which side a triangle is on, so a triangle with no corner facing
+// the eye is decided by its (u, v) centre.
+// On any surface, open ones too, a triangle whose three corners lie on the contour curve and
+// whose centre faces away: it belongs to the back sheet of a fold, which the front sheet
+// covers where the outline is convex; where the outline is concave (a spike's flanks, a
+// curved strip seen edge-on) its chord spans the concavity and stands pixels past the outline.
 constexpr double kBackFacingCos = 1e-3;
 
-size_t cullBackFacing(const FaceDomains& domains, const Camera& camera, int face,
-                      FacePiece& piece) {
+size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, bool closed,
+                  FacePiece& piece) {
   auto facing = [&](const Vec3& position, const Vec3& normal) {
     const double cosine =
         contourFunction(camera, position, normal) / length(camera.viewVector(position));
@@ -172,13 +177,15 @@ size_t cullBackFacing(const FaceDomains& domains, const Camera& camera, int face
   }
   const size_t before = piece.triangles.size();
   std::erase_if(piece.triangles, [&](const std::array<int, 3>& t) {
-    if (side[t[0]] < 0 || side[t[1]] < 0 || side[t[2]] < 0) return false;
-    if (side[t[0]] > 0 && side[t[1]] > 0 && side[t[2]] > 0) return true;
-    const Vec2& a = piece.points[t[0]].uv;
-    const Vec2& b = piece.points[t[1]].uv;
-    const Vec2& c = piece.points[t[2]].uv;
+    const int a = side[t[0]], b = side[t[1]], c = side[t[2]];
+    if (a < 0 || b < 0 || c < 0) return false;
+    if (a > 0 && b > 0 && c > 0) return closed;
+    if (!closed && (a != 0 || b != 0 || c != 0)) return false;
+    const Vec2& ua = piece.points[t[0]].uv;
+    const Vec2& ub = piece.points[t[1]].uv;
+    const Vec2& uc = piece.points[t[2]].uv;
     const subdiv::LimitSample centre =
-        domains.evaluate(face, {(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3});
+        domains.evaluate(face, {(ua.x + ub.x + uc.x) / 3, (ua.y + ub.y + uc.y) / 3});
     return facing(centre.position, centre.normal) > 0;
   });
   return before - piece.triangles.size();
@@ -198,14 +205,16 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
   out.stats.refinedFaces = chords.refinedFaces;
 
   const int faceCount = surface.faceCount();
-  const bool cull = options.cullHidden && isClosed(surface);
+  const bool closed = isClosed(surface);
   std::vector<FacePiece> pieces(faceCount);
   parallelFor(faceCount, 32, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       if ((f & 63) == 0) cancel.check();
       if (!surface.hasLimit(static_cast<int>(f))) continue;
       pieces[f] = buildFace(domains, camera, out.search, chords, options, static_cast<int>(f));
-      if (cull) pieces[f].culled = cullBackFacing(domains, camera, static_cast<int>(f), pieces[f]);
+      if (options.cullHidden) {
+        pieces[f].culled = cullHidden(domains, camera, static_cast<int>(f), closed, pieces[f]);
+      }
     }
   });
   cancel.check();

@@ -27,8 +27,9 @@ struct SilhouetteOptions {
   CurveOptions curves;
   ChordOptions chords;
   size_t maxTriangles = 8'000'000;
-  // On closed surfaces, leave out triangles whose corners all face away from the eye (hidden
-  // there; drawn, their chords can show through along inner contours).
+  // Leave out triangles that cannot be seen: on closed surfaces those facing away from the eye
+  // (drawn, their chords can show through along inner contours), on any surface the back
+  // sheet's triangles cornered on the contour alone (their chords span a concave outline).
   bool cullHidden = true;
 };
 
