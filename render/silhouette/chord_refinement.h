@@ -25,7 +25,12 @@ struct ChordOptions {
   // passes close in front of another part (a torus's hole seen nearly closed) the faces two
   // rings out still project next to it.
   int rings = 2;
-  int maxFaceSplits = 256;  // interior edge splits per face (face_refinement.h)
+  int maxFaceSplits = 64;  // interior edge splits per face (face_refinement.h)
+  // ... and per face at an infinitely sharp corner, where the surface comes to a cusp whose
+  // flanks bend within a small corner of (u, v), so that midpoint splits need many more steps.
+  // Not everywhere: on smooth dense meshes more splits chased sub-tolerance sags into slivers
+  // (the 1,280-face triangle sphere: twice the triangles and no closer).
+  int maxCuspFaceSplits = 256;
 };
 
 struct ChordRefinement {

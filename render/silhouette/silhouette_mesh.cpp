@@ -64,8 +64,63 @@ bool tessellateRingFace(const FaceDomains& domains, const ContourSearch& search,
   return true;
 }
 
+// True when the surface is closed: no boundary or non-manifold edge, no hole. A ray's first hit
+// on a closed surface enters it, so what faces away from the eye is never seen there.
+bool isClosed(const subdiv::LimitSurface& surface) {
+  const Far::TopologyLevel& base = surface.baseLevel();
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!surface.hasLimit(f)) return false;
+  }
+  for (int e = 0; e < base.GetNumEdges(); ++e) {
+    if (base.IsEdgeBoundary(e) || base.IsEdgeNonManifold(e)) return false;
+  }
+  return true;
+}
+
+// Leaves out triangles that cannot be seen. On a closed surface, every triangle that faces away
+// from the eye: it is hidden there, but its flat chord lies on the eye's side of the true
+// surface, so next to an inner contour it could poke through the front's chords, which lie
+// behind it (the dark fringes of back faces along a fold). A corner faces away when the cosine
+// between its limit normal and the view ray is above kBackFacingCos; corners on the contour
+// (cosine about 0) do not say which side a triangle is on, so a triangle with no corner facing
+// the eye is decided by its (u, v) centre.
+// On any surface, open ones too, a triangle whose three corners lie on the contour curve and
+// whose centre faces away: it belongs to the back sheet of a fold, which the front sheet
+// covers where the outline is convex; where the outline is concave (a spike's flanks, a
+// curved strip seen edge-on) its chord spans the concavity and stands pixels past the outline.
+constexpr double kBackFacingCos = 1e-3;
+
+size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, bool closed,
+                  FacePiece& piece) {
+  auto facing = [&](const Vec3& position, const Vec3& normal) {
+    const double cosine =
+        contourFunction(camera, position, normal) / length(camera.viewVector(position));
+    return cosine > kBackFacingCos ? 1 : cosine < -kBackFacingCos ? -1 : 0;
+  };
+  std::vector<int> side(piece.points.size());
+  for (size_t i = 0; i < piece.points.size(); ++i) {
+    side[i] = facing(piece.points[i].position, piece.points[i].normal);
+  }
+  const size_t before = piece.triangles.size();
+  std::erase_if(piece.triangles, [&](const std::array<int, 3>& t) {
+    const int a = side[t[0]], b = side[t[1]], c = side[t[2]];
+    if (a < 0 || b < 0 || c < 0) return false;
+    if (a > 0 && b > 0 && c > 0) return closed;
+    if (!closed && (a != 0 || b != 0 || c != 0)) return false;
+    const Vec2& ua = piece.points[t[0]].uv;
+    const Vec2& ub = piece.points[t[1]].uv;
+    const Vec2& uc = piece.points[t[2]].uv;
+    const subdiv::LimitSample centre =
+        domains.evaluate(face, {(ua.x + ub.x + uc.x) / 3, (ua.y + ub.y + uc.y) / 3});
+    return facing(centre.position, centre.normal) > 0;
+  });
+  return before - piece.triangles.size();
+}
+
+// `closed`: isClosed(surface), for cullHidden.
 FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const ContourSearch& search,
-                    const ChordRefinement& chords, const SilhouetteOptions& options, int face) {
+                    const ChordRefinement& chords, const SilhouetteOptions& options, bool closed,
+                    int face) {
   const subdiv::LimitSurface& surface = domains.surface();
   FacePiece piece;
   FaceBoundary boundary = faceBoundary(domains, search, face);
@@ -120,6 +175,11 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
     sharpSide = sharpSide ||
                 (!base.IsEdgeBoundary(e) && base.GetEdgeSharpness(e) >= mesh::kInfiniteSharpness);
   }
+  bool cusp = false;  // at an infinitely sharp corner
+  for (int v : base.GetFaceVertices(face)) {
+    cusp = cusp ||
+           (!base.IsVertexBoundary(v) && base.GetVertexSharpness(v) >= mesh::kInfiniteSharpness);
+  }
   // A ring face whose edges carry more than their uniform points (a crossing seen from the
   // neighbour only) had no Bfr tessellation above; its ear-clipped fan is split the same way.
   const bool ringFallback = chords.interiorRates[face] >= 2;
@@ -131,64 +191,15 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
       chain.push_back(path.to);
       chains.push_back(std::move(chain));
     }
-    piece.splits = refineFaceTriangles(
-        domains, camera, face, static_cast<int>(boundary.points.size()), chains,
-        options.chords.tolerancePx, options.chords.maxFaceSplits, piece.points, piece.triangles);
+    // Hidden triangles go first, so that none is split only to be left out.
+    if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, closed, piece);
+    piece.splits =
+        refineFaceTriangles(domains, camera, face, static_cast<int>(boundary.points.size()), chains,
+                            options.chords.tolerancePx,
+                            cusp ? options.chords.maxCuspFaceSplits : options.chords.maxFaceSplits,
+                            piece.points, piece.triangles);
   }
   return piece;
-}
-
-// True when the surface is closed: no boundary or non-manifold edge, no hole. A ray's first hit
-// on a closed surface enters it, so what faces away from the eye is never seen there.
-bool isClosed(const subdiv::LimitSurface& surface) {
-  const Far::TopologyLevel& base = surface.baseLevel();
-  for (int f = 0; f < surface.faceCount(); ++f) {
-    if (!surface.hasLimit(f)) return false;
-  }
-  for (int e = 0; e < base.GetNumEdges(); ++e) {
-    if (base.IsEdgeBoundary(e) || base.IsEdgeNonManifold(e)) return false;
-  }
-  return true;
-}
-
-// Leaves out triangles that cannot be seen. On a closed surface, every triangle that faces away
-// from the eye: it is hidden there, but its flat chord lies on the eye's side of the true
-// surface, so next to an inner contour it could poke through the front's chords, which lie
-// behind it (the dark fringes of back faces along a fold). A corner faces away when the cosine
-// between its limit normal and the view ray is above kBackFacingCos; corners on the contour
-// (cosine about 0) do not say which side a triangle is on, so a triangle with no corner facing
-// the eye is decided by its (u, v) centre.
-// On any surface, open ones too, a triangle whose three corners lie on the contour curve and
-// whose centre faces away: it belongs to the back sheet of a fold, which the front sheet
-// covers where the outline is convex; where the outline is concave (a spike's flanks, a
-// curved strip seen edge-on) its chord spans the concavity and stands pixels past the outline.
-constexpr double kBackFacingCos = 1e-3;
-
-size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, bool closed,
-                  FacePiece& piece) {
-  auto facing = [&](const Vec3& position, const Vec3& normal) {
-    const double cosine =
-        contourFunction(camera, position, normal) / length(camera.viewVector(position));
-    return cosine > kBackFacingCos ? 1 : cosine < -kBackFacingCos ? -1 : 0;
-  };
-  std::vector<int> side(piece.points.size());
-  for (size_t i = 0; i < piece.points.size(); ++i) {
-    side[i] = facing(piece.points[i].position, piece.points[i].normal);
-  }
-  const size_t before = piece.triangles.size();
-  std::erase_if(piece.triangles, [&](const std::array<int, 3>& t) {
-    const int a = side[t[0]], b = side[t[1]], c = side[t[2]];
-    if (a < 0 || b < 0 || c < 0) return false;
-    if (a > 0 && b > 0 && c > 0) return closed;
-    if (!closed && (a != 0 || b != 0 || c != 0)) return false;
-    const Vec2& ua = piece.points[t[0]].uv;
-    const Vec2& ub = piece.points[t[1]].uv;
-    const Vec2& uc = piece.points[t[2]].uv;
-    const subdiv::LimitSample centre =
-        domains.evaluate(face, {(ua.x + ub.x + uc.x) / 3, (ua.y + ub.y + uc.y) / 3});
-    return facing(centre.position, centre.normal) > 0;
-  });
-  return before - piece.triangles.size();
 }
 
 }  // namespace
@@ -211,10 +222,10 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
     for (size_t f = begin; f < end; ++f) {
       if ((f & 63) == 0) cancel.check();
       if (!surface.hasLimit(static_cast<int>(f))) continue;
-      pieces[f] = buildFace(domains, camera, out.search, chords, options, static_cast<int>(f));
-      if (options.cullHidden) {
-        pieces[f].culled = cullHidden(domains, camera, static_cast<int>(f), closed, pieces[f]);
-      }
+      FacePiece& piece = pieces[f];
+      const int face = static_cast<int>(f);
+      piece = buildFace(domains, camera, out.search, chords, options, closed, face);
+      if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, closed, piece);
     }
   });
   cancel.check();

@@ -13,9 +13,8 @@
 // Known open cases (issue 10's closing note), held to what they reach today so that they cannot
 // get worse unseen: the cube with infinitely sharp corners (its spikes' needle tips, up to 3.4 px;
 // on one of the views Embree's subdivision surface is as far from the reference: docs/engine.md),
-// and one open
-// corpus shape with two of four views at 1.25 px (loop_triangle_edgecorner: boundary corners seen
-// edge-on).
+// and one open corpus shape with two of four views at 1.25 px (loop_triangle_edgecorner: boundary
+// corners seen edge-on).
 #include <gtest/gtest.h>
 
 #include <cstdio>
