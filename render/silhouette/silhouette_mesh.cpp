@@ -225,6 +225,7 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
       FacePiece& piece = pieces[f];
       const int face = static_cast<int>(f);
       piece = buildFace(domains, camera, out.search, chords, options, closed, face);
+      // Again after buildFace: it culls only the faces it splits, and before the splits.
       if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, closed, piece);
     }
   });

@@ -51,7 +51,7 @@ struct SilhouetteStats {
   size_t interiorSplits = 0;  // contour-face edges split because their chord lay outside
   size_t trianglesAdded = 0;  // triangles drawn beyond the coarse mesh's
   size_t trianglesDrawn = 0;
-  size_t trianglesCulled = 0;  // facing away on a closed surface, left out (cullHidden)
+  size_t trianglesCulled = 0;  // left out as hidden (SilhouetteOptions::cullHidden)
   size_t curveSamples = 0;
   size_t unresolvedSamples = 0;  // exact samples that found no root (left on the straight line)
   size_t oddFaces = 0;           // faces with an odd crossing count (drawn without a curve)
