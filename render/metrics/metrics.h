@@ -5,6 +5,7 @@
 
 #include "render/core/cancel.h"
 #include "render/core/image.h"
+#include "render/metrics/coverage_distance.h"
 #include "render/subdiv/limit_surface.h"
 #include "render/tessellate/triangle_mesh.h"
 
@@ -49,8 +50,18 @@ struct Metrics {
 // Throws std::invalid_argument for masks of different sizes, not one channel, or a size that is
 // not a multiple of `supersample`. `cancel` is checked every band of rows (32768^2 masks take
 // seconds), throwing Cancelled.
+//
+// With `geometry`, a contour pixel of one mask more than a mask pixel from the other's contour
+// and outside the other's geometry is measured to that geometry instead where it is nearer: a
+// feature narrower than the samples is then not counted as missing from the mask that lost it
+// (coverage_distance.h says why). hausdorffPx and meanPx are then no longer multiples of 1/S.
+struct SilhouetteGeometry {
+  const CoverageDistanceQuery* approximation = nullptr;  // of `mask`
+  const CoverageDistanceQuery* reference = nullptr;      // of `referenceMask`
+};
 SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask, int supersample,
-                                     const CancelToken& cancel = CancelToken{});
+                                     const CancelToken& cancel = CancelToken{},
+                                     const SilhouetteGeometry& geometry = {});
 // Coverage comes from each set's "mask" pass, else the colour's alpha (> 0.5), else depth > 0.
 // Missing or mismatched passes throw std::invalid_argument.
 //

@@ -19,6 +19,7 @@
 #include "render/core/cancel.h"
 #include "render/core/image.h"
 #include "render/core/vec.h"
+#include "render/metrics/coverage_distance.h"
 
 namespace limn::render::metrics {
 
@@ -60,6 +61,11 @@ struct OutlineDistances {
 // nearest segment (or lone point) of the other, wherever that lies. Empty outlines: nothing when
 // both are empty is 0; when only one is, the answer is `farPx` (the image diagonal) for both
 // numbers, as for the mask metrics.
-OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx);
+// With the outlines' geometry (`geometryA` of a, `geometryB` of b), a point further than 0.1 px
+// from the other outline and outside the other's geometry is measured to that geometry where it
+// is nearer, as compareSilhouettes does (coverage_distance.h).
+OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx,
+                                 const CoverageDistanceQuery* geometryA = nullptr,
+                                 const CoverageDistanceQuery* geometryB = nullptr);
 
 }  // namespace limn::render::metrics

@@ -1,5 +1,6 @@
 // compareOutlines: see outline.h. Every located point of one outline is measured to the
-// nearest segment of the other through a bucket grid of segments.
+// nearest segment of the other through a bucket grid of segments, and where it is more than
+// kRemeasurePx away, to the other's geometry when the caller has it.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -9,18 +10,12 @@
 #include <utility>
 #include <vector>
 
+#include "render/metrics/coverage_distance.h"
 #include "render/metrics/outline.h"
 
 namespace limn::render::metrics {
 
 namespace {
-double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
-  double dx = b.x - a.x, dy = b.y - a.y;
-  double len2 = dx * dx + dy * dy;
-  double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
 // The segments of an outline (lone points as zero-length ones) bucketed in a uniform grid, for
 // nearest-segment queries that look at a few cells around the query point.
 class SegmentIndex {
@@ -104,8 +99,14 @@ bool insideFrame(const Outline& o, Vec2 p) {
   return p.x >= 0.5 && p.y >= 0.5 && p.x <= o.frameWidth - 0.5 && p.y <= o.frameHeight - 0.5;
 }
 
-// Distances from every point of `from` inside its frame to the nearest item of `index`.
-std::vector<double> directedDistances(const Outline& from, const SegmentIndex& index) {
+// Points further than this from the other outline are measured again on the other's geometry
+// when it can be (coverage_distance.h).
+constexpr double kRemeasurePx = 0.1;
+
+// Distances from every point of `from` inside its frame to the nearest item of `index`, lowered
+// to the distance to `toGeometry` (when given) where that is nearer.
+std::vector<double> directedDistances(const Outline& from, const SegmentIndex& index,
+                                      const CoverageDistanceQuery* toGeometry) {
   std::vector<Vec2> measured;
   for (Vec2 p : from.points) {
     if (insideFrame(from, p)) measured.push_back(p);
@@ -116,12 +117,27 @@ std::vector<double> directedDistances(const Outline& from, const SegmentIndex& i
                       for (size_t k = r.begin(); k < r.end(); ++k)
                         d[k] = index.nearest(measured[k]);
                     });
+  if (!toGeometry) return d;
+  std::vector<size_t> far;
+  std::vector<Vec2> points;
+  std::vector<double> bounds;
+  for (size_t k = 0; k < d.size(); ++k) {
+    if (d[k] <= kRemeasurePx) continue;
+    far.push_back(k);
+    points.push_back(measured[k]);
+    bounds.push_back(d[k]);
+  }
+  if (far.empty()) return d;
+  (*toGeometry)(points, bounds);
+  for (size_t i = 0; i < far.size(); ++i) d[far[i]] = std::min(d[far[i]], bounds[i]);
   return d;
 }
 
 }  // namespace
 
-OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx) {
+OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx,
+                                 const CoverageDistanceQuery* geometryA,
+                                 const CoverageDistanceQuery* geometryB) {
   if (a.empty() && b.empty()) return {};
   if (a.empty() || b.empty()) return {farPx, farPx};
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
@@ -134,7 +150,8 @@ OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farP
     }
   }
   SegmentIndex indexA(a, x0, y0, x1, y1), indexB(b, x0, y0, x1, y1);
-  std::vector<double> ab = directedDistances(a, indexB), ba = directedDistances(b, indexA);
+  std::vector<double> ab = directedDistances(a, indexB, geometryB);
+  std::vector<double> ba = directedDistances(b, indexA, geometryA);
   OutlineDistances result;
   double sum = 0;
   for (const std::vector<double>* d : {&ab, &ba}) {

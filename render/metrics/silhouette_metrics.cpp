@@ -6,7 +6,9 @@
 //   1. one pass over both float masks gives a byte per pixel with four flags (covered in A,
 //      in B, contour of A, of B) and counts IoU and the majority mismatch on the way;
 //   2. per direction, the column pass of the distance transform over one contour, then row
-//      envelopes only on the rows where the other contour has pixels.
+//      envelopes only on the rows where the other contour has pixels;
+//   3. with the renderings' geometry, the few contour pixels more than a pixel from the other
+//      contour are measured again to the other's triangles (coverage_distance.h).
 // Every pass runs in parallel over rows or column stripes; per-row partial results are summed
 // in row order afterwards, so the numbers do not depend on the thread count.
 #include <tbb/blocked_range.h>
@@ -15,11 +17,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "render/metrics/coverage_distance.h"
 #include "render/metrics/distance_transform.h"
 #include "render/metrics/metrics.h"
 
@@ -136,18 +140,32 @@ Classified classify(const Image& a, const Image& b, int s, const CancelToken& ca
 }
 
 struct DirectedDistances {
-  double max = 0, sum = 0;
+  double max = 0, sum = 0;  // mask pixels
   long count = 0;
+};
+
+// Contour pixels further than this (squared, mask pixels) from the other contour are measured
+// again on the other's geometry when it can be (coverage_distance.h); nearer ones cannot gain.
+constexpr int64_t kRemeasureSquared = 2;
+
+// A contour pixel to measure again, and its sampled distance (mask pixels).
+struct Remeasure {
+  int x, y;
+  double distance;
 };
 
 // Distances from every pixel flagged `fromBit` to the nearest pixel behind `to` (the column
 // pass of the other contour). Only rows holding `fromBit` pixels build their envelope; the
-// caller guarantees `to` has at least one feature.
+// caller guarantees `to` has at least one feature. With `remeasure`, pixels over
+// kRemeasureSquared are listed there and left out of the max (not of the sum).
 DirectedDistances directedDistances(const Classified& flags, uint8_t fromBit,
-                                    const ColumnDistances& to, const CancelToken& cancel) {
+                                    const ColumnDistances& to, const CancelToken& cancel,
+                                    std::vector<Remeasure>* remeasure) {
   const int width = to.width(), height = to.height();
   std::vector<double> rowMax(height, 0.0), rowSum(height, 0.0);
   std::vector<long> rowCount(height, 0);
+  std::vector<std::vector<Remeasure>> rowRemeasure(remeasure ? height : 0);
+  const int64_t keepBelow = remeasure ? kRemeasureSquared : std::numeric_limits<int64_t>::max();
   tbb::parallel_for(tbb::blocked_range<int>(0, height, kRowGrain),
                     [&](const tbb::blocked_range<int>& rows) {
                       cancel.check();
@@ -162,8 +180,13 @@ DirectedDistances directedDistances(const Classified& flags, uint8_t fromBit,
                         for (int x = 0; x < width; ++x) {
                           if (!(row[x] & fromBit)) continue;
                           const int64_t d2 = envelope.squaredDistanceAt(x);
-                          worst = std::max(worst, d2);
-                          sum += std::sqrt(static_cast<double>(d2));
+                          const double d = std::sqrt(static_cast<double>(d2));
+                          if (d2 < keepBelow) {
+                            worst = std::max(worst, d2);
+                          } else {
+                            rowRemeasure[y].push_back({x, y, d});
+                          }
+                          sum += d;
                           ++count;
                         }
                         rowMax[y] = std::sqrt(static_cast<double>(worst));
@@ -176,8 +199,44 @@ DirectedDistances directedDistances(const Classified& flags, uint8_t fromBit,
     total.max = std::max(total.max, rowMax[y]);
     total.sum += rowSum[y];
     total.count += rowCount[y];
+    if (remeasure)
+      remeasure->insert(remeasure->end(), rowRemeasure[y].begin(), rowRemeasure[y].end());
   }
   return total;
+}
+
+// Measures the listed pixels again with `query` (output pixels; see coverage_distance.h) and
+// folds their distances, lowered where the geometry is nearer than the samples, into `total`.
+void foldRemeasured(const std::vector<Remeasure>& remeasure, double s,
+                    const CoverageDistanceQuery& query, DirectedDistances& total) {
+  if (remeasure.empty()) return;
+  std::vector<Vec2> points;
+  std::vector<double> distances;
+  points.reserve(remeasure.size());
+  distances.reserve(remeasure.size());
+  for (const Remeasure& r : remeasure) {
+    points.push_back({(r.x + 0.5) / s, (r.y + 0.5) / s});
+    distances.push_back(r.distance / s);
+  }
+  query(points, distances);
+  for (size_t k = 0; k < remeasure.size(); ++k) {
+    const double d = std::min(remeasure[k].distance, distances[k] * s);
+    total.max = std::max(total.max, d);
+    total.sum += d - remeasure[k].distance;
+  }
+}
+
+// The distances from the contour pixels flagged `fromBit` to the other contour (whose column
+// pass `to` holds), measured again on the other's geometry where `toGeometry` is given.
+DirectedDistances contourDistances(const Classified& flags, uint8_t fromBit,
+                                   const ColumnDistances& to, double s,
+                                   const CoverageDistanceQuery* toGeometry,
+                                   const CancelToken& cancel) {
+  std::vector<Remeasure> remeasure;
+  DirectedDistances d =
+      directedDistances(flags, fromBit, to, cancel, toGeometry ? &remeasure : nullptr);
+  if (toGeometry) foldRemeasured(remeasure, s, *toGeometry, d);
+  return d;
 }
 
 void checkMasks(const Image& mask, const Image& referenceMask, int supersample) {
@@ -208,7 +267,8 @@ void checkMasks(const Image& mask, const Image& referenceMask, int supersample) 
 }  // namespace
 
 SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask, int supersample,
-                                     const CancelToken& cancel) {
+                                     const CancelToken& cancel,
+                                     const SilhouetteGeometry& geometry) {
   checkMasks(mask, referenceMask, supersample);
   const int width = mask.width, height = mask.height;
   const double s = supersample;
@@ -233,9 +293,11 @@ SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMa
 
   ColumnDistances columns(width, height);
   columns.compute(flags.pixels.get(), kContourB, cancel);
-  const DirectedDistances aToB = directedDistances(flags, kContourA, columns, cancel);
+  const DirectedDistances aToB =
+      contourDistances(flags, kContourA, columns, s, geometry.reference, cancel);
   columns.compute(flags.pixels.get(), kContourA, cancel);
-  const DirectedDistances bToA = directedDistances(flags, kContourB, columns, cancel);
+  const DirectedDistances bToA =
+      contourDistances(flags, kContourB, columns, s, geometry.approximation, cancel);
   result.hausdorffPx = std::max(aToB.max, bToA.max) / s;
   result.meanPx = (aToB.sum + bToA.sum) / static_cast<double>(aToB.count + bToA.count) / s;
   return result;

@@ -95,6 +95,7 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
   }
   const ReferenceTessellation& tessellation = built->tessellation;
   const tessellate::TriangleMesh& mesh = tessellation.mesh;
+  result.coverageMesh = std::shared_ptr<const tessellate::TriangleMesh>(built, &mesh);
   RTCScene scene = built->scene.get();
   stats.triangles = mesh.triangleCount();
   stats.outlineFaces = tessellation.outlineFaces;

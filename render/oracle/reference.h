@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,9 @@ struct ReferenceResult {
   // Per output pixel: its S x S mask samples were all cast (elsewhere the mask is uniform over
   // the pixel's block and equal to its neighbours'): where outlines can be, for locateOutline.
   std::vector<char> refinedPixels;
+  // The triangles the rays were cast against, so what the reference covers (the silhouette
+  // metrics measure distances to it: metrics/coverage_distance.h). Null for implicit surfaces.
+  std::shared_ptr<const tessellate::TriangleMesh> coverageMesh;
   ReferenceStats stats;
   std::vector<std::string> warnings;
 };

@@ -96,7 +96,7 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
   }
   cancel.check();
 
-  Far::PatchTableFactory::Options options = subdiv::bfrPatchOptions(isolation);
+  Far::PatchTableFactory::Options options = subdiv::bfrPatchOptions(sharpIsolation(isolation));
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
   adaptive.secondaryLevel = isolation;
   refiner->RefineAdaptive(adaptive);

@@ -13,6 +13,7 @@
 #include <opensubdiv/far/patchTable.h>
 #include <opensubdiv/far/stencilTable.h>
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "render/core/vec.h"
 #include "render/mesh/control_mesh.h"
 #include "render/subdiv/displacement.h"
+#include "render/subdiv/limit_surface.h"
 
 namespace limn::render::patches {
 
@@ -36,6 +38,13 @@ const char* patchKindName(PatchKind kind);
 // and sharp corners (bench/patches_results.md). And the most a request may ask for.
 inline constexpr int kDefaultIsolation = 6;
 inline constexpr int kMaxIsolation = 8;
+// Infinitely sharp features are isolated deeper than smooth ones, as Bfr does (they converge
+// far more slowly: subdiv::kApproxLevelSharp): at the default isolation to Bfr's sharp level,
+// elsewhere as many levels deeper, up to the deepest Far supports.
+constexpr int sharpIsolation(int isolation) {
+  return std::min(isolation + subdiv::kApproxLevelSharp - subdiv::kApproxLevel,
+                  subdiv::kApproxLevelSharp);
+}
 
 struct Patch {
   OpenSubdiv::Far::PatchTable::PatchHandle handle;

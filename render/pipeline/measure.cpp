@@ -1,6 +1,7 @@
 #include "render/pipeline/measure.h"
 
 #include <cmath>
+#include <optional>
 
 #include "render/metrics/metrics.h"
 
@@ -11,14 +12,25 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
                                const oracle::ReferenceResult& reference, double diagonal, bool diff,
                                const CancelToken& cancel) {
   const ImageSet& refImages = reference.images;
+  // Both geometries, so that features narrower than the samples count as what they are.
+  const metrics::CoverageDistanceQuery approxGeometry =
+      metrics::meshCoverageDistance(approx, camera, cancel);
+  std::optional<metrics::CoverageDistanceQuery> referenceGeometry;
+  if (reference.coverageMesh) {
+    referenceGeometry = metrics::meshCoverageDistance(*reference.coverageMesh, camera, cancel);
+  }
+  const metrics::CoverageDistanceQuery* toReference =
+      referenceGeometry ? &*referenceGeometry : nullptr;
   metrics::Metrics m;
   m.silhouette =
-      metrics::compareSilhouettes(images.supersampledMask, refImages.supersampledMask, S, cancel);
+      metrics::compareSilhouettes(images.supersampledMask, refImages.supersampledMask, S, cancel,
+                                  {.approximation = &approxGeometry, .reference = toReference});
   // The reference was hinted with this mask: its refined pixels hold all of its outline.
   metrics::Outline outline = oracle::locateMeshOutline(approx, camera, images.supersampledMask, S,
                                                        cancel, &reference.refinedPixels);
   metrics::OutlineDistances d = metrics::compareOutlines(
-      outline, reference.outline, std::hypot(camera.width(), camera.height()));
+      outline, reference.outline, std::hypot(camera.width(), camera.height()), &approxGeometry,
+      toReference);
   m.silhouette->outlineHausdorffPx = d.hausdorffPx;
   m.silhouette->outlineMeanPx = d.meanPx;
   m.image = metrics::compareColor(images, refImages);

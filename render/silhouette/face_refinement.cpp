@@ -1,6 +1,7 @@
 #include "render/silhouette/face_refinement.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -12,6 +13,36 @@ namespace {
 
 using Edge = std::pair<int, int>;
 Edge key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
+
+// How many triangles use each edge, the edge named by its two end positions (so that distinct
+// points at one position count as one), kept as triangles come and go; folded() when an edge
+// has more than two.
+class EdgeUses {
+ public:
+  explicit EdgeUses(const std::vector<FacePoint>& points) : points_(points) {}
+  void addTriangle(const std::array<int, 3>& t) { change(t, +1); }
+  void removeTriangle(const std::array<int, 3>& t) { change(t, -1); }
+  bool folded() const { return overused_ > 0; }
+
+ private:
+  using Position = std::array<double, 3>;
+  Position at(int i) const {
+    const Vec3& p = points_[i].position;
+    return {p.x, p.y, p.z};
+  }
+  void change(const std::array<int, 3>& t, int delta) {
+    for (int k = 0; k < 3; ++k) {
+      const Position a = at(t[k]), b = at(t[(k + 1) % 3]);
+      int& count = uses_[a < b ? std::make_pair(a, b) : std::make_pair(b, a)];
+      overused_ -= count > 2;
+      count += delta;
+      overused_ += count > 2;
+    }
+  }
+  const std::vector<FacePoint>& points_;
+  std::map<std::pair<Position, Position>, int> uses_;
+  int overused_ = 0;  // edges used more than twice
+};
 
 }  // namespace
 
@@ -59,6 +90,17 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
   const std::vector<std::array<int, 3>> original = triangles;
   const size_t originalPoints = points.size();
 
+  // In 3D, no edge may be shared by more than two triangles: that would be a fold, which the
+  // surface pinching next to a sharp corner produces when a midpoint lands on an existing edge.
+  // Each split is checked as it is made and undone if it folds, so one bad split near a spike
+  // costs only itself (checking once at the end and undoing every split of the face left whole
+  // fans of chords pixels outside the outline, depending on the camera to the last bit).
+  // Positions are compared exactly: many splits next to a sharp corner put distinct points
+  // within float rounding of each other, which is no fold.
+  EdgeUses uses(points);
+  for (const auto& t : triangles) uses.addTriangle(t);
+  if (uses.folded()) return 0;  // splits cannot undo a fold the face came with
+
   int splits = 0;
   // Each edge's sag is evaluated once: a split only adds edges.
   struct Sag {
@@ -102,24 +144,36 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
     if (target.first < 0) break;
 
     // Split it: each triangle (a, b, c) on the edge becomes (a, m, c) and (m, b, c), unless a
-    // half would have no area in (u, v) (slivers next to a sharp corner, split many times).
+    // half would have no area in (u, v) (slivers next to a sharp corner, split many times) or
+    // the split folds.
     const int m = static_cast<int>(points.size());
     points.push_back(targetMiddle);
     std::vector<std::pair<size_t, std::array<int, 3>>> halves;  // (triangle, first half)
     std::vector<std::array<int, 3>> secondHalves;
-    bool degenerate = false;
-    for (size_t i = 0; i < triangles.size() && !degenerate; ++i) {
+    bool rejected = false;
+    for (size_t i = 0; i < triangles.size() && !rejected; ++i) {
       const std::array<int, 3>& t = triangles[i];
       for (int k = 0; k < 3; ++k) {
         int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
         if (key(a, b) != target) continue;
         halves.push_back({i, {a, m, c}});
         secondHalves.push_back({m, b, c});
-        degenerate = !(uvArea({a, m, c}) > 0) || !(uvArea({m, b, c}) > 0);
+        rejected = !(uvArea({a, m, c}) > 0) || !(uvArea({m, b, c}) > 0);
         break;
       }
     }
-    if (degenerate) {
+    if (!rejected) {
+      for (const auto& [at, half] : halves) uses.removeTriangle(triangles[at]);
+      for (const auto& [at, half] : halves) uses.addTriangle(half);
+      for (const auto& half : secondHalves) uses.addTriangle(half);
+      if (uses.folded()) {
+        for (const auto& half : secondHalves) uses.removeTriangle(half);
+        for (const auto& [at, half] : halves) uses.removeTriangle(half);
+        for (const auto& [at, half] : halves) uses.addTriangle(triangles[at]);
+        rejected = true;
+      }
+    }
+    if (rejected) {
       points.pop_back();
       sags[target].px = 0;
       continue;
@@ -128,28 +182,9 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
     triangles.insert(triangles.end(), secondHalves.begin(), secondHalves.end());
     ++splits;
   }
-  // In 3D, no edge may be shared by more than two triangles (that would be a fold, which the
-  // surface pinching near a crease has produced).
-  auto folded = [&] {
-    // Positions compared exactly: many splits next to a sharp corner put distinct points within
-    // float rounding of each other, which is no fold.
-    using Key = std::pair<std::array<double, 3>, std::array<double, 3>>;
-    std::map<Key, int> uses;
-    auto at = [&](int i) {
-      const Vec3& p = points[i].position;
-      return std::array<double, 3>{p.x, p.y, p.z};
-    };
-    for (const auto& t : triangles) {
-      for (int k = 0; k < 3; ++k) {
-        auto a = at(t[k]), b = at(t[(k + 1) % 3]);
-        if (++uses[std::minmax(a, b)] > 2) return true;
-      }
-    }
-    return false;
-  };
   double areaAfter = 0;
   if (splits > 0 && tiledBefore &&
-      (!tiling(&areaAfter) || std::fabs(areaAfter - areaBefore) > 1e-9 * areaBefore || folded())) {
+      (!tiling(&areaAfter) || std::fabs(areaAfter - areaBefore) > 1e-9 * areaBefore)) {
     triangles = original;
     points.resize(originalPoints);
     return 0;

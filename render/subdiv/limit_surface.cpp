@@ -185,7 +185,7 @@ void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
   }
   Bfr::RefinerSurfaceFactory<>::Options options;
   options.SetApproxLevelSmooth(kApproxLevel);
-  options.SetApproxLevelSharp(kApproxLevel);
+  options.SetApproxLevelSharp(kApproxLevelSharp);
   Bfr::RefinerSurfaceFactory<> factory(*refiner_, options);
 
   std::vector<double> meshPoints;

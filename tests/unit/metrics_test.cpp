@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "render/metrics/coverage_distance.h"
 #include "render/metrics/outline.h"
 #include "render/subdiv/limit_surface.h"
 #include "tests/unit/test_meshes.h"
@@ -725,6 +727,111 @@ TEST(Outline, SaddleCellsFollowTheQuery) {
     EXPECT_TRUE(std::min(fx, 1 - fx) < 2e-3 || std::min(fy, 1 - fy) < 2e-3);
   }
   EXPECT_GE(o.segments.size(), o.points.size() - 64);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Distances to a rendering's geometry (coverage_distance.h): triangles placed in the image plane
+// of an orthographic camera, so their projections are known exactly.
+
+// The queries keep a reference to their token.
+const CancelToken kNever;
+
+Camera pixelCamera(int width, int height) {
+  return Camera({0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 45, Projection::Orthographic, height, width,
+                height, 0.1, 100);
+}
+
+// Triangles given by their corners in output pixels, placed in front of `camera`.
+tessellate::TriangleMesh trianglesAt(const Camera& camera,
+                                     const std::vector<std::array<Vec2, 3>>& triangles) {
+  tessellate::TriangleMesh mesh;
+  for (const auto& corners : triangles) {
+    for (const Vec2& p : corners) {
+      const Ray ray = camera.rayThrough(p.x, p.y);
+      mesh.indices.push_back(static_cast<uint32_t>(mesh.positions.size()));
+      mesh.positions.push_back(Vec3f(ray.origin + ray.direction * 5.0));
+    }
+  }
+  return mesh;
+}
+
+TEST(CoverageDistance, PointToTriangleInsideOnEdgesAndPastCorners) {
+  const Vec2 a{0, 0}, b{4, 0}, c{0, 3};
+  EXPECT_EQ(pointTriangleDistance({1, 1}, a, b, c), 0.0);
+  EXPECT_EQ(pointTriangleDistance({1, 1}, a, c, b), 0.0);  // either winding
+  EXPECT_NEAR(pointTriangleDistance({2, -0.5}, a, b, c), 0.5, 1e-12);
+  EXPECT_NEAR(pointTriangleDistance({-3, -4}, a, b, c), 5.0, 1e-12);
+  EXPECT_NEAR(pointTriangleDistance({4, 3}, a, b, c), 2.4, 1e-12);  // to the hypotenuse
+  // A degenerate triangle is its segment: no inside, and points past its end are not on it.
+  EXPECT_NEAR(pointTriangleDistance({6, 0}, a, b, {2, 0}), 2.0, 1e-12);
+}
+
+TEST(CoverageDistance, LowersBoundsToTheNearestCoveredPointOnly) {
+  const Camera camera = pixelCamera(64, 48);
+  // A needle 0.02 px wide along y = 10 from x = 10 to its tip at x = 40, and a square.
+  const tessellate::TriangleMesh mesh =
+      trianglesAt(camera, {{Vec2{10, 9.99}, Vec2{10, 10.01}, Vec2{40, 10}},
+                           {Vec2{30, 30}, Vec2{40, 30}, Vec2{40, 40}},
+                           {Vec2{30, 30}, Vec2{40, 40}, Vec2{30, 40}}});
+  const CoverageDistanceQuery query = meshCoverageDistance(mesh, camera, kNever);
+  const std::vector<Vec2> points = {{25, 10.5}, {43, 10}, {35, 35}, {35, 27}, {5, 45}};
+  std::vector<double> distances = {3.0, 3.0, 3.0, 3.0, 1.5};
+  query(points, distances);
+  EXPECT_NEAR(distances[0], 0.495, 1e-6);  // beside the needle (0.005 px half-wide there)
+  EXPECT_NEAR(distances[1], 3.0, 1e-3);    // past its tip: exactly the bound
+  EXPECT_EQ(distances[2], 3.0);            // covered: the bound stays
+  EXPECT_NEAR(distances[3], 3.0, 1e-3);    // 3 px above the square
+  EXPECT_EQ(distances[4], 1.5);            // nothing within the bound
+}
+
+TEST(CoverageDistance, NeedleNarrowerThanTheSamplesIsNotAGapInTheSilhouette) {
+  // Output 16 x 16 px at S = 4. Both renderings hold a square [4, 10]^2 and a needle from it to
+  // x = 15 along y = 7; rendering A's needle is wide enough for its row of samples, B's lies
+  // between two rows of samples, so B's mask has no needle at all.
+  constexpr int kSize = 16, kS = 4;
+  const Camera camera = pixelCamera(kSize, kSize);
+  const std::vector<std::array<Vec2, 3>> square = {{Vec2{4, 4}, Vec2{10, 4}, Vec2{10, 10}},
+                                                   {Vec2{4, 4}, Vec2{10, 10}, Vec2{4, 10}}};
+  auto withNeedle = [&](double y0, double y1) {
+    auto triangles = square;
+    triangles.push_back({Vec2{10, y0}, Vec2{10, y1}, Vec2{15, 0.5 * (y0 + y1)}});
+    return trianglesAt(camera, triangles);
+  };
+  const tessellate::TriangleMesh meshA = withNeedle(6.95, 7.3), meshB = withNeedle(7.01, 7.09);
+  // The masks as a rasteriser samples them: covered where a sample lies in a triangle.
+  auto maskOf = [&](double y0, double y1) {
+    auto triangles = square;
+    triangles.push_back({Vec2{10, y0}, Vec2{10, y1}, Vec2{15, 0.5 * (y0 + y1)}});
+    Image mask(kSize * kS, kSize * kS, 1);
+    for (int j = 0; j < kSize * kS; ++j) {
+      for (int i = 0; i < kSize * kS; ++i) {
+        const Vec2 p{(i + 0.5) / kS, (j + 0.5) / kS};
+        for (const auto& t : triangles) {
+          if (pointTriangleDistance(p, t[0], t[1], t[2]) == 0) mask.at(i, j) = 1.0f;
+        }
+      }
+    }
+    return mask;
+  };
+  const Image maskA = maskOf(6.95, 7.3), maskB = maskOf(7.01, 7.09);
+  ASSERT_GT(maskA.at(13 * kS, 7 * kS), 0.5f);  // A's needle has samples
+  ASSERT_LT(maskB.at(13 * kS, 7 * kS), 0.5f);  // B's has none
+  const SilhouetteMetrics sampled = compareSilhouettes(maskA, maskB, kS);
+  EXPECT_GT(sampled.hausdorffPx, 2.0);  // the samples see a missing needle
+  const CoverageDistanceQuery geometryA = meshCoverageDistance(meshA, camera, kNever);
+  const CoverageDistanceQuery geometryB = meshCoverageDistance(meshB, camera, kNever);
+  const SilhouetteMetrics measured = compareSilhouettes(
+      maskA, maskB, kS, CancelToken{}, {.approximation = &geometryA, .reference = &geometryB});
+  EXPECT_LT(measured.hausdorffPx, 0.35);  // the needles are a fraction of a pixel apart
+  EXPECT_LT(measured.meanPx, sampled.meanPx);
+  // A real difference stays: B without its needle is the needle's length from A.
+  const tessellate::TriangleMesh squareOnly = trianglesAt(camera, square);
+  const CoverageDistanceQuery geometrySquare = meshCoverageDistance(squareOnly, camera, kNever);
+  const SilhouetteMetrics missing = compareSilhouettes(
+      maskA, maskB, kS, CancelToken{}, {.approximation = &geometryA, .reference = &geometrySquare});
+  // (to the square's edge itself, not to its samples' centres: up to half a sample nearer)
+  EXPECT_GT(missing.hausdorffPx, 4.5);
+  EXPECT_NEAR(missing.hausdorffPx, sampled.hausdorffPx, 0.5 / kS);
 }
 
 }  // namespace

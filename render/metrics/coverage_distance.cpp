@@ -1,0 +1,167 @@
+// meshCoverageDistance: see coverage_distance.h. The points to measure are few (the outline
+// samples the sampled distances put more than a sample away from the other outline), the
+// triangles many (a reference has up to millions), so the points go into a grid, each in every
+// cell its search disc reaches, and every triangle visits the cells under its bounding box.
+#include "render/metrics/coverage_distance.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace limn::render::metrics {
+
+namespace {
+
+constexpr double kMinCellPx = 4;
+constexpr int kMaxCellsPerSide = 512;
+constexpr size_t kTriangleGrain = 8192;
+
+double cross(const Vec2& a, const Vec2& b, const Vec2& p) {
+  return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+}
+
+// The points, each listed in every cell its disc (radius: its current bound) overlaps.
+class PointGrid {
+ public:
+  PointGrid(const std::vector<Vec2>& points, const std::vector<double>& radii) {
+    double x0 = std::numeric_limits<double>::max(), y0 = x0, x1 = -x0, y1 = -x0;
+    for (size_t k = 0; k < points.size(); ++k) {
+      x0 = std::min(x0, points[k].x - radii[k]);
+      y0 = std::min(y0, points[k].y - radii[k]);
+      x1 = std::max(x1, points[k].x + radii[k]);
+      y1 = std::max(y1, points[k].y + radii[k]);
+    }
+    x0_ = x0;
+    y0_ = y0;
+    cell_ = std::max({kMinCellPx, (x1 - x0) / kMaxCellsPerSide, (y1 - y0) / kMaxCellsPerSide});
+    nx_ = static_cast<int>((x1 - x0) / cell_) + 1;
+    ny_ = static_cast<int>((y1 - y0) / cell_) + 1;
+    cells_.resize(static_cast<size_t>(nx_) * ny_);
+    for (size_t k = 0; k < points.size(); ++k) {
+      const Vec2& p = points[k];
+      forCells(p.x - radii[k], p.y - radii[k], p.x + radii[k], p.y + radii[k],
+               [&](std::vector<int>& cell) { cell.push_back(static_cast<int>(k)); });
+    }
+  }
+
+  // Calls `visit` with every cell overlapping the box (clipped to the grid).
+  template <typename Visit>
+  void forCells(double xa, double ya, double xb, double yb, Visit&& visit) {
+    const int i0 = std::max(0, static_cast<int>(std::floor((xa - x0_) / cell_)));
+    const int j0 = std::max(0, static_cast<int>(std::floor((ya - y0_) / cell_)));
+    const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((xb - x0_) / cell_)));
+    const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((yb - y0_) / cell_)));
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) visit(cells_[static_cast<size_t>(j) * nx_ + i]);
+    }
+  }
+
+ private:
+  double x0_ = 0, y0_ = 0, cell_ = kMinCellPx;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::vector<int>> cells_;
+};
+
+// Per thread: the smallest distance found for each point, and whether a triangle covers it.
+struct Nearest {
+  std::vector<double> distance;
+  std::vector<char> covered;
+};
+
+void lowerToMeshDistances(const tessellate::TriangleMesh& mesh, const Camera& camera,
+                          const CancelToken& cancel, const std::vector<Vec2>& points,
+                          std::vector<double>& distances) {
+  if (points.empty()) return;
+  const size_t vertexCount = mesh.positions.size();
+  std::vector<Vec2> projected(vertexCount);
+  std::vector<char> inFront(vertexCount);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, kTriangleGrain),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t v = range.begin(); v < range.end(); ++v) {
+                        const Vec3f& q = mesh.positions[v];
+                        const Vec3 p = camera.project(Vec3{q.x, q.y, q.z});
+                        projected[v] = {p.x, p.y};
+                        inFront[v] = p.z > camera.nearPlane();
+                      }
+                    });
+  cancel.check();
+
+  PointGrid grid(points, distances);
+  tbb::enumerable_thread_specific<Nearest> nearest(
+      [&] { return Nearest{distances, std::vector<char>(points.size(), 0)}; });
+  const size_t triangles = mesh.indices.size() / 3;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, kTriangleGrain),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      if (cancel.expired()) return;
+                      Nearest& mine = nearest.local();
+                      for (size_t t = range.begin(); t < range.end(); ++t) {
+                        const uint32_t* corner = &mesh.indices[3 * t];
+                        if (!inFront[corner[0]] || !inFront[corner[1]] || !inFront[corner[2]]) {
+                          continue;
+                        }
+                        const Vec2 &a = projected[corner[0]], &b = projected[corner[1]],
+                                   &c = projected[corner[2]];
+                        const double xa = std::min({a.x, b.x, c.x}), xb = std::max({a.x, b.x, c.x});
+                        const double ya = std::min({a.y, b.y, c.y}), yb = std::max({a.y, b.y, c.y});
+                        grid.forCells(xa, ya, xb, yb, [&](const std::vector<int>& cell) {
+                          for (int k : cell) {
+                            const Vec2& p = points[k];
+                            // The box's distance bounds the triangle's from below.
+                            const double bx = std::max({xa - p.x, 0.0, p.x - xb});
+                            const double by = std::max({ya - p.y, 0.0, p.y - yb});
+                            if (std::hypot(bx, by) >= mine.distance[k] && !(bx == 0 && by == 0)) {
+                              continue;
+                            }
+                            const double d = pointTriangleDistance(p, a, b, c);
+                            if (d == 0) mine.covered[k] = 1;
+                            mine.distance[k] = std::min(mine.distance[k], d);
+                          }
+                        });
+                      }
+                    });
+  cancel.check();
+  for (size_t k = 0; k < points.size(); ++k) {
+    double lowest = distances[k];
+    bool covered = false;
+    for (const Nearest& n : nearest) {
+      lowest = std::min(lowest, n.distance[k]);
+      covered = covered || n.covered[k];
+    }
+    if (!covered) distances[k] = lowest;
+  }
+}
+
+}  // namespace
+
+double pointSegmentDistance(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double length2 = dx * dx + dy * dy;
+  double t = length2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / length2 : 0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+double pointTriangleDistance(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c) {
+  const double area = cross(a, b, c);
+  if (area != 0) {
+    // Inside when p is on the inner side of all three edges, whatever the winding.
+    const double s = area > 0 ? 1 : -1;
+    if (s * cross(a, b, p) >= 0 && s * cross(b, c, p) >= 0 && s * cross(c, a, p) >= 0) return 0;
+  }
+  return std::min({pointSegmentDistance(p, a, b), pointSegmentDistance(p, b, c),
+                   pointSegmentDistance(p, c, a)});
+}
+
+CoverageDistanceQuery meshCoverageDistance(const tessellate::TriangleMesh& mesh,
+                                           const Camera& camera, const CancelToken& cancel) {
+  return [&mesh, &camera, &cancel](const std::vector<Vec2>& points,
+                                   std::vector<double>& distances) {
+    lowerToMeshDistances(mesh, camera, cancel, points, distances);
+  };
+}
+
+}  // namespace limn::render::metrics

@@ -1,0 +1,44 @@
+// Distances from image points to a rendering's coverage, measured on its triangles rather than
+// on its samples.
+//
+// The silhouette metrics find outlines where the samples of a mask change (1/S output px apart).
+// A feature narrower than that spacing — the last pixels of a spike tapering to a point — is
+// covered by no sample, so it is missing from the mask while the geometry still reaches there.
+// Where two renderings draw the same spike with widths a few hundredths of a pixel apart, their
+// samples lose it at points pixels apart along its length, and the sampled distances call that
+// a gap of pixels (3.4 px on a cube with infinitely sharp corners at 512^2, S = 4; the gap
+// changes with S, which the geometry does not). Measuring from a point outside the other shape
+// to that shape's triangles gives the distance the metric means: to the nearest point the
+// other rendering covers.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "render/core/camera.h"
+#include "render/core/cancel.h"
+#include "render/core/vec.h"
+#include "render/tessellate/triangle_mesh.h"
+
+namespace limn::render::metrics {
+
+// Image-plane points in output pixels (as outline.h). On entry distances[k] is an upper bound
+// for points[k] (the distance the samples gave); it is lowered to the distance from points[k]
+// to the nearest covered point where that is smaller and points[k] itself is not covered.
+// Points the geometry covers keep their bound: there the distance wanted is to the edge of the
+// coverage, which the samples measure. The query may run on several threads.
+using CoverageDistanceQuery =
+    std::function<void(const std::vector<Vec2>& points, std::vector<double>& distances)>;
+
+// The query for `mesh` seen by `camera`, covering what rasterising or ray casting its triangles
+// covers. Triangles reaching behind the eye or the near plane are left out (their projection is
+// not a triangle), which can only leave a bound unlowered. `mesh`, `camera` and `cancel` must
+// outlive the query; `cancel` is checked between batches of triangles.
+CoverageDistanceQuery meshCoverageDistance(const tessellate::TriangleMesh& mesh,
+                                           const Camera& camera, const CancelToken& cancel);
+
+// Distance from `p` to the segment [a, b], and to the closed triangle (a, b, c) (0 inside).
+double pointSegmentDistance(const Vec2& p, const Vec2& a, const Vec2& b);
+double pointTriangleDistance(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c);
+
+}  // namespace limn::render::metrics
