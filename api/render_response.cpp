@@ -139,6 +139,7 @@ void writeSilhouetteStats(Writer& w, const render::silhouette::SilhouetteStats& 
   count("edgesWithSignChange", s.search.edgesWithSignChange);
   count("edgesSampled", s.search.edgesSampled);
   count("doubleCrossingEdges", s.search.doubleCrossings);
+  count("interiorLoopFaces", s.search.interiorLoopFaces);
   count("outlineEdges", s.search.outlineEdges);
   count("contourPoints", s.search.contourPoints);
   count("contourFaces", s.contourFaces);

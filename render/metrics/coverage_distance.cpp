@@ -91,8 +91,9 @@ void lowerToMeshDistances(const tessellate::TriangleMesh& mesh, const Camera& ca
   cancel.check();
 
   PointGrid grid(points, distances);
-  tbb::enumerable_thread_specific<Nearest> nearest(
-      [&] { return Nearest{distances, std::vector<char>(points.size(), 0)}; });
+  tbb::enumerable_thread_specific<Nearest> nearest([&] {
+    return Nearest{distances, std::vector<char>(points.size(), 0)};
+  });
   const size_t triangles = mesh.indices.size() / 3;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, kTriangleGrain),
                     [&](const tbb::blocked_range<size_t>& range) {
@@ -158,10 +159,10 @@ double pointTriangleDistance(const Vec2& p, const Vec2& a, const Vec2& b, const 
 
 CoverageDistanceQuery meshCoverageDistance(const tessellate::TriangleMesh& mesh,
                                            const Camera& camera, const CancelToken& cancel) {
-  return [&mesh, &camera, &cancel](const std::vector<Vec2>& points,
-                                   std::vector<double>& distances) {
-    lowerToMeshDistances(mesh, camera, cancel, points, distances);
-  };
+  return
+      [&mesh, &camera, &cancel](const std::vector<Vec2>& points, std::vector<double>& distances) {
+        lowerToMeshDistances(mesh, camera, cancel, points, distances);
+      };
 }
 
 }  // namespace limn::render::metrics

@@ -130,6 +130,81 @@ Vec2 edgeUV(const FaceDomains& domains, int face, int edge, double t) {
   return domains.alongEdge(face, where.corner, where.forward ? t : 1 - t);
 }
 
+namespace {
+
+// Interior points sampled for a loop: on the fan from the domain's centre to each edge.
+constexpr double kLoopFanSteps[] = {0.25, 0.5, 0.75};
+
+// True when g keeps the corners' sign nowhere inside `face` can be ruled out and a sample
+// inside has the other sign (ContourSearch::loopFaces).
+bool holdsContourLoop(const FaceDomains& domains, const Camera& camera, const ContourSearch& out,
+                      int face) {
+  const subdiv::LimitSurface& surface = domains.surface();
+  const std::vector<Vec3>& limitPositions = surface.controlLimitPositions();
+  const mesh::ControlMesh& cage = surface.mesh();
+  const size_t first = out.faceOffsets[face], last = out.faceOffsets[face + 1];
+  const int sign = signOf(out.cornerG[first]);
+  double nearest = kPi, turnNormals = 0, turnRays = 0;
+  for (size_t i = first; i < last; ++i) {
+    if (signOf(out.cornerG[i]) != sign) return false;  // its edges hold the crossings
+    const Vec3 ray = camera.viewVector(limitPositions[cage.faceVertexIndices[i]]);
+    nearest = std::min(nearest, std::asin(std::min(1.0, std::fabs(out.cornerG[i]) /
+                                                            std::max(length(ray), 1e-300))));
+    for (size_t j = first; j < i; ++j) {
+      turnNormals = std::max(turnNormals, angleBetween(out.cornerNormals[i], out.cornerNormals[j]));
+      turnRays =
+          std::max(turnRays,
+                   angleBetween(ray, camera.viewVector(limitPositions[cage.faceVertexIndices[j]])));
+    }
+  }
+  if (nearest > 1.5 * turnNormals + turnRays + kPi / 180.0) return false;
+  const int corners = static_cast<int>(last - first);
+  const Vec2 centre = domains.center(face);
+  auto differs = [&](const Vec2& uv) {
+    const subdiv::LimitSample s = domains.evaluate(face, uv);
+    return signOf(contourFunction(camera, s.position, s.normal)) != sign;
+  };
+  if (differs(centre)) return true;
+  for (int k = 0; k < corners; ++k) {
+    const Vec2 a = domains.corner(face, k), b = domains.corner(face, (k + 1) % corners);
+    for (double s : kLoopFanSteps) {
+      for (double t : kLoopFanSteps) {
+        const Vec2 edge{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+        if (differs({centre.x + s * (edge.x - centre.x), centre.y + s * (edge.y - centre.y)})) {
+          return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+// The faces holding a contour loop, in face order.
+std::vector<int> findLoopFaces(const FaceDomains& domains, const Camera& camera,
+                               const ContourSearch& out, const CancelToken& cancel) {
+  const subdiv::LimitSurface& surface = domains.surface();
+  const Far::TopologyLevel& base = surface.baseLevel();
+  const int faceCount = surface.faceCount();
+  std::vector<char> loop(faceCount, 0);
+  parallelFor(faceCount, 64, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      if ((f & 255) == 0) cancel.check();
+      const int face = static_cast<int>(f);
+      if (!surface.hasLimit(face)) continue;
+      bool crossed = false;
+      for (int e : base.GetFaceEdges(face)) crossed = crossed || !out.edgePoints[e].empty();
+      loop[f] = !crossed && holdsContourLoop(domains, camera, out, face);
+    }
+  });
+  std::vector<int> faces;
+  for (int f = 0; f < faceCount; ++f) {
+    if (loop[f]) faces.push_back(f);
+  }
+  return faces;
+}
+
+}  // namespace
+
 ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
                             const SearchOptions& options, const CancelToken& cancel) {
   const subdiv::LimitSurface& surface = domains.surface();
@@ -306,6 +381,8 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
   });
   cancel.check();
 
+  out.loopFaces = findLoopFaces(domains, camera, out, cancel);
+
   out.stats.edgesTested = tested;
   out.stats.edgesWithSignChange = signChanges;
   out.stats.edgesSampled = sampled;
@@ -313,6 +390,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
   out.stats.outlineEdges = outlines;
   out.stats.edgesOnTables = onTables;
   for (const auto& points : out.edgePoints) out.stats.contourPoints += points.size();
+  out.stats.interiorLoopFaces = out.loopFaces.size();
   return out;
 }
 

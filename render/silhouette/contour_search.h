@@ -68,6 +68,7 @@ struct SearchStats {
   size_t outlineEdges = 0;         // boundary or sharp edges drawn along their limit curve
   size_t edgesOnTables = 0;        // sampled edges whose dyadic samples came from edge tables
   size_t contourPoints = 0;        // distinct edge points
+  size_t interiorLoopFaces = 0;    // faces whose contour lies inside them (ContourSearch)
 };
 
 struct ContourSearch {
@@ -77,6 +78,12 @@ struct ContourSearch {
   std::vector<Vec3> cornerNormals;
   std::vector<size_t> faceOffsets;  // start of each face's corners in the arrays above
   std::vector<std::vector<EdgePoint>> edgePoints;  // per base edge, sorted by t
+  // Faces without a crossing on their edges in which g still changes sign: a contour loop lies
+  // inside them (a small bump seen edge-on; an eye so close that all it sees is one face).
+  // Found like double crossings: a face whose corners the bound cannot clear (the normal and
+  // view-ray turn across the face against the corners' angles to the tangent plane) is
+  // sampled on a fan of interior points. The silhouette mesh tessellates them finely.
+  std::vector<int> loopFaces;
   SearchStats stats;
 };
 

@@ -64,6 +64,28 @@ bool tessellateRingFace(const FaceDomains& domains, const ContourSearch& search,
   return true;
 }
 
+// A face holding a contour loop (ContourSearch::loopFaces) is drawn as Bfr's tessellation
+// with this inner rate: segments about kLoopSegmentPx long across the face's projection, so
+// that the tessellation's own outline follows the loop (a polygon of such segments around a
+// loop of radius r px stays within kLoopSegmentPx^2 / (8 r) of it), at most kMaxLoopRate.
+// Corners behind the eye (the eye so close that the face fills the view) get the most.
+constexpr double kLoopSegmentPx = 2.0;
+constexpr int kMaxLoopRate = 64;
+
+int loopRate(const FaceDomains& domains, const Camera& camera, int face) {
+  std::vector<Vec3> corners;
+  for (int k = 0; k < domains.size(face); ++k) {
+    const Vec3 p = camera.project(domains.position(face, domains.corner(face, k)));
+    if (p.z <= camera.nearPlane()) return kMaxLoopRate;
+    corners.push_back(p);
+  }
+  double span = 0;
+  for (const Vec3& a : corners) {
+    for (const Vec3& b : corners) span = std::max(span, std::hypot(a.x - b.x, a.y - b.y));
+  }
+  return std::clamp(static_cast<int>(std::ceil(span / kLoopSegmentPx)), 4, kMaxLoopRate);
+}
+
 // True when the surface is closed: no boundary or non-manifold edge, no hole. A ray's first hit
 // on a closed surface enters it, so what faces away from the eye is never seen there.
 bool isClosed(const subdiv::LimitSurface& surface) {
@@ -210,8 +232,12 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
   const FaceDomains domains(surface);
   out.search = searchContour(domains, camera, options.search, cancel);
   out.stats.search = out.search.stats;
-  const ChordRefinement chords = refineConcaveChords(
-      domains, camera, contourFaces(surface, out.search), options.chords, out.search);
+  ChordRefinement chords = refineConcaveChords(domains, camera, contourFaces(surface, out.search),
+                                               options.chords, out.search);
+  for (int face : out.search.loopFaces) {
+    chords.interiorRates[face] =
+        std::max(chords.interiorRates[face], loopRate(domains, camera, face));
+  }
   out.stats.refinedEdges = chords.refinedEdges;
   out.stats.refinedFaces = chords.refinedFaces;
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <tuple>
+#include <vector>
 
 #include "render/silhouette/contour_search.h"
 #include "render/silhouette/face_triangulation.h"
@@ -135,6 +136,61 @@ TEST(ContourSearch, FindsBothCrossingsOfAnEdgeWhoseEndsAgree) {
     EXPECT_EQ(doubled, 5);
     EXPECT_GE(search.stats.doubleCrossings, 5u);
   }
+}
+
+// A 5 x 5 grid of unit quads with the four corners of its middle face raised: a bump whose far
+// flank, seen from 30 degrees above (looking along +y), turns away from the eye in a small region
+// that crosses none of the edges of the face it lies in (face 17: x 2-3, y 3-4).
+ControlMesh bump() {
+  ControlMesh m;
+  for (int j = 0; j < 6; ++j) {
+    for (int i = 0; i < 6; ++i) {
+      const bool raised = (i == 2 || i == 3) && (j == 2 || j == 3);
+      m.points.push_back({static_cast<double>(i), static_cast<double>(j), raised ? 0.8 : 0.0});
+    }
+  }
+  for (int j = 0; j < 5; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      const int a = j * 6 + i;
+      addFace(m, {a, a + 1, a + 7, a + 6});
+    }
+  }
+  return m;
+}
+
+Camera bumpView(double elevationDeg) {
+  const double e = elevationDeg * std::acos(-1.0) / 180.0;
+  const Vec3 target{2.5, 2.5, 0.4};
+  return Camera(target + Vec3{0, -12 * std::cos(e), 12 * std::sin(e)}, target, {0, 0, 1}, 30,
+                Projection::Perspective, 0, 256, 256, 1, 40);
+}
+
+TEST(ContourSearch, FindsALoopInsideOneFaceAndTessellatesIt) {
+  subdiv::LimitSurface surface(bump());
+  const FaceDomains domains(surface);
+  ContourSearch search = searchContour(domains, bumpView(30), {}, CancelToken());
+  ASSERT_EQ(search.loopFaces, std::vector<int>{17});
+  EXPECT_EQ(search.stats.interiorLoopFaces, 1u);
+  for (int e : surface.baseLevel().GetFaceEdges(17)) EXPECT_TRUE(search.edgePoints[e].empty());
+  // g really changes sign inside: the centre faces the eye, the loop does not.
+  int away = 0, towards = 0;
+  for (int j = 1; j < 16; ++j) {
+    for (int i = 1; i < 16; ++i) {
+      const subdiv::LimitSample s = domains.evaluate(17, {i / 16.0, j / 16.0});
+      (contourFunction(bumpView(30), s.position, s.normal) > 0 ? away : towards) += 1;
+    }
+  }
+  EXPECT_GT(away, 0);
+  EXPECT_GT(towards, 0);
+  // Drawn as a fine tessellation rather than the face's two triangles.
+  SilhouetteOptions options;
+  options.cullHidden = false;
+  SilhouetteMesh drawn = buildSilhouetteMesh(surface, bumpView(30), options, CancelToken());
+  size_t inLoopFace = 0;
+  for (int32_t f : drawn.mesh.triangleFaces) inLoopFace += f == 17;
+  EXPECT_GE(inLoopFace, 32u);
+  // From higher up the whole bump faces the eye: no loop.
+  EXPECT_TRUE(searchContour(domains, bumpView(45), {}, CancelToken()).loopFaces.empty());
 }
 
 TEST(ContourSearch, ExactCurvesLieOnTheContour) {

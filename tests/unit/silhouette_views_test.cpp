@@ -10,11 +10,9 @@
 // along a contour, tests/support/wrong_side.h) beyond kMaxBandPixels.
 // A failure prints the camera, which reproduces the view through /v1/render.
 //
-// Known open cases (issue 10's closing note), held to what they reach today so that they cannot
-// get worse unseen: the cube with infinitely sharp corners (its spikes' needle tips, up to 3.4 px;
-// on one of the views Embree's subdivision surface is as far from the reference: docs/engine.md),
-// and one open corpus shape with two of four views at 1.25 px (loop_triangle_edgecorner: boundary
-// corners seen edge-on).
+// Known open case (issue 10's closing note), held to what it reaches today so that it cannot get
+// worse unseen: one open corpus shape with two of four views at 1.25 px (loop_triangle_edgecorner:
+// boundary corners seen edge-on).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -45,10 +43,7 @@ struct Allowance {
 };
 
 Allowance allowanceFor(const std::string& shape, bool closed) {
-  // Its spikes' needle tips, under a pixel wide: up to 3.4 px on two of the four views
-  // (docs/engine.md).
-  if (shape == "own_cube_sharp_corners") return {3.4, 2};
-  if (shape == "loop_triangle_edgecorner") return {3.0, 2};
+  if (shape == "loop_triangle_edgecorner") return {1.5, 2};
   return closed ? Allowance{1.0, 0} : Allowance{3.0, 1};
 }
 
