@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <mutex>
 
 namespace limn::render::metrics {
 
@@ -19,6 +21,7 @@ namespace {
 constexpr double kMinCellPx = 4;
 constexpr int kMaxCellsPerSide = 512;
 constexpr size_t kTriangleGrain = 8192;
+constexpr size_t kFirstBatch = 256;
 
 double cross(const Vec2& a, const Vec2& b, const Vec2& p) {
   return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
@@ -72,22 +75,40 @@ struct Nearest {
   std::vector<char> covered;
 };
 
-void lowerToMeshDistances(const tessellate::TriangleMesh& mesh, const Camera& camera,
-                          const CancelToken& cancel, const std::vector<Vec2>& points,
+// The mesh's vertices in the image plane, projected on the query's first call and kept for
+// the next (lowerLargestFirst calls it once per batch).
+struct ProjectedMesh {
+  const tessellate::TriangleMesh& mesh;
+  const Camera& camera;
+  const CancelToken& cancel;
+  std::once_flag once;
+  std::vector<Vec2> projected;
+  std::vector<char> inFront;  // in front of the near plane
+
+  void project() {
+    const size_t vertexCount = mesh.positions.size();
+    projected.resize(vertexCount);
+    inFront.resize(vertexCount);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, kTriangleGrain),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                        for (size_t v = range.begin(); v < range.end(); ++v) {
+                          const Vec3f& q = mesh.positions[v];
+                          const Vec3 p = camera.project(Vec3{q.x, q.y, q.z});
+                          projected[v] = {p.x, p.y};
+                          inFront[v] = p.z > camera.nearPlane();
+                        }
+                      });
+  }
+};
+
+void lowerToMeshDistances(ProjectedMesh& projection, const std::vector<Vec2>& points,
                           std::vector<double>& distances) {
   if (points.empty()) return;
-  const size_t vertexCount = mesh.positions.size();
-  std::vector<Vec2> projected(vertexCount);
-  std::vector<char> inFront(vertexCount);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexCount, kTriangleGrain),
-                    [&](const tbb::blocked_range<size_t>& range) {
-                      for (size_t v = range.begin(); v < range.end(); ++v) {
-                        const Vec3f& q = mesh.positions[v];
-                        const Vec3 p = camera.project(Vec3{q.x, q.y, q.z});
-                        projected[v] = {p.x, p.y};
-                        inFront[v] = p.z > camera.nearPlane();
-                      }
-                    });
+  std::call_once(projection.once, [&] { projection.project(); });
+  const tessellate::TriangleMesh& mesh = projection.mesh;
+  const CancelToken& cancel = projection.cancel;
+  const std::vector<Vec2>& projected = projection.projected;
+  const std::vector<char>& inFront = projection.inFront;
   cancel.check();
 
   PointGrid grid(points, distances);
@@ -159,10 +180,40 @@ double pointTriangleDistance(const Vec2& p, const Vec2& a, const Vec2& b, const 
 
 CoverageDistanceQuery meshCoverageDistance(const tessellate::TriangleMesh& mesh,
                                            const Camera& camera, const CancelToken& cancel) {
-  return
-      [&mesh, &camera, &cancel](const std::vector<Vec2>& points, std::vector<double>& distances) {
-        lowerToMeshDistances(mesh, camera, cancel, points, distances);
-      };
+  auto projection =
+      std::shared_ptr<ProjectedMesh>(new ProjectedMesh{mesh, camera, cancel, {}, {}, {}});
+  return [projection](const std::vector<Vec2>& points, std::vector<double>& distances) {
+    lowerToMeshDistances(*projection, points, distances);
+  };
+}
+
+void lowerLargestFirst(const CoverageDistanceQuery& query, const std::vector<Vec2>& points,
+                       std::vector<double>& distances) {
+  std::vector<size_t> order(points.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return distances[a] > distances[b]; });
+  double measuredMax = 0;
+  size_t done = 0, batch = kFirstBatch;
+  std::vector<Vec2> batchPoints;
+  std::vector<double> batchDistances;
+  while (done < order.size() && distances[order[done]] > measuredMax) {
+    const size_t end = std::min(order.size(), done + batch);
+    batchPoints.clear();
+    batchDistances.clear();
+    for (size_t i = done; i < end; ++i) {
+      batchPoints.push_back(points[order[i]]);
+      batchDistances.push_back(distances[order[i]]);
+    }
+    query(batchPoints, batchDistances);
+    for (size_t i = done; i < end; ++i) {
+      double& d = distances[order[i]];
+      d = std::min(d, batchDistances[i - done]);
+      measuredMax = std::max(measuredMax, d);
+    }
+    done = end;
+    batch *= 2;
+  }
 }
 
 }  // namespace limn::render::metrics

@@ -37,6 +37,15 @@ using CoverageDistanceQuery =
 CoverageDistanceQuery meshCoverageDistance(const tessellate::TriangleMesh& mesh,
                                            const Camera& camera, const CancelToken& cancel);
 
+// Lowers every bound in `distances` with `query` where that can change the largest: the points
+// go to the query largest bound first, in batches that double (256 first), until the largest
+// bound left is no more than the largest distance measured so far; those left keep their bounds
+// (which can only overstate a mean by what they would have been lowered). So a rendering far off
+// everywhere (a coarse mesh, 100k outline points pixels away) costs a batch or two, not a search
+// around every point.
+void lowerLargestFirst(const CoverageDistanceQuery& query, const std::vector<Vec2>& points,
+                       std::vector<double>& distances);
+
 // Distance from `p` to the segment [a, b], and to the closed triangle (a, b, c) (0 inside).
 double pointSegmentDistance(const Vec2& p, const Vec2& a, const Vec2& b);
 double pointTriangleDistance(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c);

@@ -128,7 +128,7 @@ std::vector<double> directedDistances(const Outline& from, const SegmentIndex& i
     bounds.push_back(d[k]);
   }
   if (far.empty()) return d;
-  (*toGeometry)(points, bounds);
+  lowerLargestFirst(*toGeometry, points, bounds);
   for (size_t i = 0; i < far.size(); ++i) d[far[i]] = std::min(d[far[i]], bounds[i]);
   return d;
 }

@@ -218,7 +218,7 @@ void foldRemeasured(const std::vector<Remeasure>& remeasure, double s,
     points.push_back({(r.x + 0.5) / s, (r.y + 0.5) / s});
     distances.push_back(r.distance / s);
   }
-  query(points, distances);
+  lowerLargestFirst(query, points, distances);
   for (size_t k = 0; k < remeasure.size(); ++k) {
     const double d = std::min(remeasure[k].distance, distances[k] * s);
     total.max = std::max(total.max, d);

@@ -100,6 +100,8 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
   adaptive.secondaryLevel = isolation;
   refiner->RefineAdaptive(adaptive);
+  // Refining appends levels to a vector inside the refiner: `base` may now dangle.
+  const Far::TopologyLevel& refinedBase = refiner->GetLevel(0);
   cancel.check();
   table_.reset(Far::PatchTableFactory::Create(*refiner, options));
   cancel.check();
@@ -126,7 +128,7 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
       const auto [face, subFace] = ptexToFace.at(patch.param.GetFaceId());
       patch.baseFace = face;
       patch.subFace = subFace;
-      patch.faceSize = base.GetFaceVertices(face).size();
+      patch.faceSize = refinedBase.GetFaceVertices(face).size();
       patch.depth = patch.param.GetDepth();
       patch.kind = kindOf(descriptor.GetType(), patch.param, onBoundary[face]);
       patch.triangle = triangle;
