@@ -72,6 +72,21 @@ const char* patchKindName(PatchKind kind) {
   return "?";
 }
 
+int sharpIsolation(const Far::TopologyLevel& base, int isolation) {
+  bool spike = false;
+  for (int v = 0; v < base.GetNumVertices(); ++v) {
+    if (base.IsVertexNonManifold(v)) return isolation;
+    spike = spike ||
+            (!base.IsVertexBoundary(v) && base.GetVertexSharpness(v) >= mesh::kInfiniteSharpness);
+  }
+  for (int e = 0; e < base.GetNumEdges(); ++e) {
+    if (base.IsEdgeNonManifold(e)) return isolation;
+  }
+  if (!spike) return isolation;
+  return std::min(isolation + subdiv::kApproxLevelSharp - subdiv::kApproxLevel,
+                  subdiv::kApproxLevelSharp);
+}
+
 PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelToken& cancel,
                    const subdiv::DisplacementSpec& displacement)
     : scheme_(mesh.scheme),
@@ -96,7 +111,8 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
   }
   cancel.check();
 
-  Far::PatchTableFactory::Options options = subdiv::bfrPatchOptions(sharpIsolation(isolation));
+  Far::PatchTableFactory::Options options =
+      subdiv::bfrPatchOptions(sharpIsolation(base, isolation));
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
   adaptive.secondaryLevel = isolation;
   refiner->RefineAdaptive(adaptive);

@@ -13,7 +13,6 @@
 #include <opensubdiv/far/patchTable.h>
 #include <opensubdiv/far/stencilTable.h>
 
-#include <algorithm>
 #include <array>
 #include <memory>
 #include <vector>
@@ -38,13 +37,14 @@ const char* patchKindName(PatchKind kind);
 // and sharp corners (bench/patches_results.md). And the most a request may ask for.
 inline constexpr int kDefaultIsolation = 6;
 inline constexpr int kMaxIsolation = 8;
-// Infinitely sharp features are isolated deeper than smooth ones, as Bfr does (they converge
-// far more slowly: subdiv::kApproxLevelSharp): at the default isolation to Bfr's sharp level,
-// elsewhere as many levels deeper, up to the deepest Far supports.
-constexpr int sharpIsolation(int isolation) {
-  return std::min(isolation + subdiv::kApproxLevelSharp - subdiv::kApproxLevel,
-                  subdiv::kApproxLevelSharp);
-}
+// Meshes with an infinitely sharp corner inside the surface (a spike) have it isolated deeper
+// than the smooth features, as Bfr does (it converges far more slowly:
+// subdiv::kApproxLevelSharp): at the default isolation to Bfr's sharp level, elsewhere as many
+// levels deeper, up to the deepest Far supports. Not every sharp feature: Far isolates all of
+// them to one level, and along sharp creases that meet irregularly (non-manifold edges) each
+// level doubles the patches along the whole crease (a corpus mesh took 33 s and exceeded the
+// limits at level 10), so meshes with non-manifold edges keep `isolation`.
+int sharpIsolation(const OpenSubdiv::Far::TopologyLevel& base, int isolation);
 
 struct Patch {
   OpenSubdiv::Far::PatchTable::PatchHandle handle;
