@@ -73,16 +73,13 @@ const char* patchKindName(PatchKind kind) {
 }
 
 int sharpIsolation(const Far::TopologyLevel& base, int isolation) {
-  bool spike = false;
-  for (int v = 0; v < base.GetNumVertices(); ++v) {
-    if (base.IsVertexNonManifold(v)) return isolation;
-    spike = spike ||
-            (!base.IsVertexBoundary(v) && base.GetVertexSharpness(v) >= mesh::kInfiniteSharpness);
+  const std::vector<char> atSpike = subdiv::facesAtSpikes(base);
+  if (std::none_of(atSpike.begin(), atSpike.end(), [](char c) { return c != 0; })) {
+    return isolation;
   }
   for (int e = 0; e < base.GetNumEdges(); ++e) {
     if (base.IsEdgeNonManifold(e)) return isolation;
   }
-  if (!spike) return isolation;
   return std::min(isolation + subdiv::kApproxLevelSharp - subdiv::kApproxLevel,
                   subdiv::kApproxLevelSharp);
 }

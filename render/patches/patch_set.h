@@ -37,13 +37,13 @@ const char* patchKindName(PatchKind kind);
 // and sharp corners (bench/patches_results.md). And the most a request may ask for.
 inline constexpr int kDefaultIsolation = 6;
 inline constexpr int kMaxIsolation = 8;
-// Meshes with an infinitely sharp corner inside the surface (a spike) have it isolated deeper
-// than the smooth features, as Bfr does (it converges far more slowly:
-// subdiv::kApproxLevelSharp): at the default isolation to Bfr's sharp level, elsewhere as many
-// levels deeper, up to the deepest Far supports. Not every sharp feature: Far isolates all of
-// them to one level, and along sharp creases that meet irregularly (non-manifold edges) each
-// level doubles the patches along the whole crease (a corpus mesh took 33 s and exceeded the
-// limits at level 10), so meshes with non-manifold edges keep `isolation`.
+// On meshes with a spike (subdiv::facesAtSpikes), sharp features are isolated deeper than
+// smooth ones, as Bfr does there (subdiv::kApproxLevelSharp says why): at the default isolation
+// to Bfr's spike level, elsewhere as many levels deeper, up to the deepest Far supports. Far
+// isolates every sharp feature of the mesh so, not only the spikes (Bfr only those: other sharp
+// features of such a mesh come out more exact than the reference's). Not on meshes with
+// non-manifold edges: there Far isolates whole sharp creases, and each level doubles their
+// patches (a corpus mesh took 33 s and exceeded the limits at level 10).
 int sharpIsolation(const OpenSubdiv::Far::TopologyLevel& base, int isolation);
 
 struct Patch {

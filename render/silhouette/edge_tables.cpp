@@ -246,7 +246,7 @@ EdgeTable::EdgeTable(mesh::Scheme scheme, int valence) : valence_(valence) {
   // Same options as LimitSurface, so that the responses are those of the surface it evaluates.
   Bfr::RefinerSurfaceFactory<>::Options options;
   options.SetApproxLevelSmooth(subdiv::kApproxLevel);
-  options.SetApproxLevelSharp(subdiv::kApproxLevelSharp);
+  options.SetApproxLevelSharp(subdiv::kApproxLevel);
   Bfr::RefinerSurfaceFactory<> factory(*refiner, options);
 
   // Point j of the mesh is the j-th unit vector: every coordinate of a result is one point's

@@ -45,8 +45,8 @@ FarPatchSurface::FarPatchSurface(std::unique_ptr<Far::TopologyRefiner> refiner,
   firstPtexFace_.resize(baseFaces);
   for (int f = 0; f < baseFaces; ++f) firstPtexFace_[f] = ptexIndices.GetFaceId(f);
 
-  // Bfr's isolation levels: sharp features to kApproxLevelSharp, smooth ones to kApproxLevel.
-  Far::PatchTableFactory::Options options = bfrPatchOptions(kApproxLevelSharp);
+  // Both isolation levels at kApproxLevel, as Bfr (away from spikes).
+  Far::PatchTableFactory::Options options = bfrPatchOptions(kApproxLevel);
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
   adaptive.secondaryLevel = kApproxLevel;
   Far::ConstIndexArray selected(faces.data(), static_cast<int>(faces.size()));

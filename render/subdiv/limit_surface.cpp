@@ -177,6 +177,18 @@ std::vector<int> LimitSurface::facesBfrCannotEvaluate() const {
   return faces;
 }
 
+std::vector<char> facesAtSpikes(const Far::TopologyLevel& base) {
+  std::vector<char> atSpike(base.GetNumFaces(), 0);
+  for (int v = 0; v < base.GetNumVertices(); ++v) {
+    if (base.IsVertexBoundary(v) || base.IsVertexNonManifold(v) ||
+        base.GetVertexSharpness(v) < mesh::kInfiniteSharpness) {
+      continue;
+    }
+    for (int f : base.GetVertexFaces(v)) atSpike[f] = 1;
+  }
+  return atSpike;
+}
+
 void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
                                      const CancelToken& cancel) {
   if (!farPatchFaces.empty()) {
@@ -185,8 +197,12 @@ void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
   }
   Bfr::RefinerSurfaceFactory<>::Options options;
   options.SetApproxLevelSmooth(kApproxLevel);
-  options.SetApproxLevelSharp(kApproxLevelSharp);
+  options.SetApproxLevelSharp(kApproxLevel);
   Bfr::RefinerSurfaceFactory<> factory(*refiner_, options);
+  // Faces at a spike (kApproxLevelSharp says why) from a factory that goes deeper there.
+  options.SetApproxLevelSharp(kApproxLevelSharp);
+  Bfr::RefinerSurfaceFactory<> spikeFactory(*refiner_, options);
+  const std::vector<char> atSpike = facesAtSpikes(baseLevel());
 
   std::vector<double> meshPoints;
   meshPoints.reserve(mesh_.points.size() * 3);
@@ -206,7 +222,8 @@ void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
       continue;
     }
     FaceSurface fs;
-    if (!factory.InitVertexSurface(f, &fs.surface) || !fs.surface.IsValid()) continue;
+    Bfr::RefinerSurfaceFactory<>& from = atSpike[f] ? spikeFactory : factory;
+    if (!from.InitVertexSurface(f, &fs.surface) || !fs.surface.IsValid()) continue;
     fs.patchPoints.resize(static_cast<size_t>(fs.surface.GetNumPatchPoints()) * 3);
     fs.surface.PreparePatchPoints(meshPoints.data(), xyz, fs.patchPoints.data(), xyz);
     faces_[f] = {true, false, static_cast<int>(surfaces_.size())};

@@ -11,8 +11,8 @@
 //
 // Parameterisation is Bfr's: quads (u, v) in [0,1]^2, triangles (u, v) with u + v <= 1, and
 // other faces of Catmull-Clark meshes tiled into quad sub-faces (see Bfr::Parameterization).
-// The approximation levels Bfr uses near irregular features are fixed (kApproxLevel and
-// kApproxLevelSharp) so that every reference made from this surface agrees.
+// The approximation levels Bfr uses near irregular features are fixed (kApproxLevel, and
+// kApproxLevelSharp at spikes) so that every reference made from this surface agrees.
 #pragma once
 
 #include <opensubdiv/bfr/parameterization.h>
@@ -30,15 +30,21 @@ namespace limn::render::subdiv {
 
 class FarPatchSurface;
 
-// Bfr refinement levels used to approximate irregular regions. Smooth features (extraordinary
-// vertices): at 6, Bfr, Far and Embree agree to about 4e-7 of the model size. Infinitely sharp
-// features converge much more slowly: next to an infinitely sharp corner whose sectors are
-// smooth (a spike), each level removes only about a third of the remaining error, so level 6
-// left the spikes of a cube with sharp corners 9e-3 of the cube's size (3 px at 512^2) off; 10
-// is the deepest OpenSubdiv patches can describe (Far::PatchParam has 10 bits per coordinate;
-// Far's patch map crashes beyond) and leaves about a fifth of that.
+// Bfr refinement level used to approximate irregular regions, for smooth and sharp features
+// alike. At 6, Bfr, Far and Embree agree to about 4e-7 of the model size.
 inline constexpr int kApproxLevel = 6;
+// Except on the faces around a spike: an interior vertex that is an infinitely sharp corner
+// (facesAtSpikes). There the surface converges much more slowly: each level removes only about
+// a third of the remaining error, so level 6 left the spikes of a cube with sharp corners 9e-3
+// of the cube's size (3 px at 512^2) off. 10 is the deepest OpenSubdiv's patches can describe
+// (Far::PatchParam has 10 bits per coordinate; Far's patch map crashes beyond) and leaves about
+// a fifth of that. Only there: Far's patch tables (FarPatchSurface, the patches method) cannot
+// follow Bfr's sharp level everywhere (Far counts irregular boundary vertices of Loop meshes
+// as smooth, Bfr as sharp), and they agree with Bfr exactly at kApproxLevel.
 inline constexpr int kApproxLevelSharp = 10;
+
+// Per base face: it has a spike corner (an infinitely sharp corner inside a manifold surface).
+std::vector<char> facesAtSpikes(const OpenSubdiv::Far::TopologyLevel& base);
 
 struct LimitSample {
   Vec3 position;
