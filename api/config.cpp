@@ -128,6 +128,7 @@ void readLimits(const Value& object, const std::string& source, ServiceConfig& c
   r.integer("maxResolution", limits.maxResolution, 2);
   r.size("maxExpressionLength", limits.maxExpressionLength, 1);
   r.size("maxCompareRows", limits.maxCompareRows, 1);
+  r.size("maxWorkerMemoryBytes", limits.maxWorkerMemoryBytes, 0);
   r.size("maxJobs", config.maxJobs, 1);
   r.size("maxJobRows", config.maxJobRows, 1);
   r.finish();
@@ -163,6 +164,10 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
     throw ConfigError(source + ": \"logLevel\" must be debug, info, warn, error or off");
   }
   r.integer("jobRetentionSeconds", config.jobRetentionSeconds, 0);
+  r.string("workerIsolation", config.workerIsolation);
+  if (config.workerIsolation != "process" && config.workerIsolation != "thread") {
+    throw ConfigError(source + ": \"workerIsolation\" must be process or thread");
+  }
   if (const Value* limits = r.object("limits")) readLimits(*limits, source, config);
   r.finish();
   return config;

@@ -20,6 +20,9 @@ struct ServiceConfig {
   int workers = 0;      // render workers; 0 = one per core
   int queueDepth = 16;  // jobs waiting for a worker before answering 429
   int ioThreads = 1;    // threads running the HTTP connections
+  // "process": each render worker is a child process (a crash costs one request); "thread":
+  // threads of the server itself (for debugging).
+  std::string workerIsolation = "process";
   size_t maxBodyBytes = 64u << 20;
   int requestTimeoutMs = 120000;
   // On SIGTERM: how long the requests already queued or running may take to finish before

@@ -67,4 +67,17 @@ Answer handleMeshUpload(std::string_view body, const render::pipeline::JobLimits
   });
 }
 
+std::optional<std::string> referencedMeshId(std::string_view body) {
+  // Inline meshes are the common case, and large: most bodies need no parse here.
+  if (body.find("\"id\"") == std::string_view::npos) return std::nullopt;
+  rapidjson::Document root;
+  root.Parse<rapidjson::kParseIterativeFlag>(body.data(), body.size());
+  if (root.HasParseError() || !root.IsObject()) return std::nullopt;
+  const json::Value* mesh = json::find(root, "mesh");
+  if (!mesh || !mesh->IsObject()) return std::nullopt;
+  const json::Value* id = json::find(*mesh, "id");
+  if (!id || !id->IsString()) return std::nullopt;
+  return std::string(id->GetString(), id->GetStringLength());
+}
+
 }  // namespace limn::api

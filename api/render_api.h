@@ -2,6 +2,7 @@
 // The server and the CLI call these; nothing below api/ knows JSON.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -66,5 +67,18 @@ Answer handleTessellate(std::string_view body, std::string_view accept,
 // whole cache is a 413 naming meshCacheBytes. Never throws.
 Answer handleMeshUpload(std::string_view body, const render::pipeline::JobLimits& limits,
                         render::mesh::MeshCache& meshes);
+
+// The images of a 200 answer of /v1/render or /v1/implicit as files: "color.png", ...,
+// and the reference's as "reference_color.png", ... (limn render writes them to a folder).
+struct DecodedImage {
+  std::string fileName;
+  std::vector<unsigned char> bytes;
+};
+std::vector<DecodedImage> imagesOf(std::string_view answerJson);
+
+// The id of the uploaded mesh a /v1/render, /v1/silhouette, /v1/tessellate or /v1/compare body
+// names ({"mesh": {"id": "..."}}), or nothing (another mesh form, or not such a body at all:
+// the handler's parse says what is wrong). For the server, which holds the uploaded meshes.
+std::optional<std::string> referencedMeshId(std::string_view body);
 
 }  // namespace limn::api

@@ -5,6 +5,7 @@
 #include "api/base64.h"
 #include "api/json_util.h"
 #include "api/render_api.h"
+#include "api/request_parts.h"
 #include "api/response_parts.h"
 
 namespace limn::api {
@@ -419,6 +420,38 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
   writeCamera(w, result.camera);
   w.EndObject();
   return {buffer.GetString(), buffer.GetSize()};
+}
+
+namespace {
+
+void appendImages(const json::Value* images, const std::string& prefix,
+                  std::vector<DecodedImage>& out) {
+  if (!images || !images->IsObject()) return;
+  for (const auto& member : images->GetObject()) {
+    const json::Value* mime = json::find(member.value, "mime");
+    const json::Value* data = json::find(member.value, "data");
+    if (!mime || !data || !mime->IsString() || !data->IsString()) continue;
+    const std::string_view type = mime->GetString();
+    const char* extension = type == "image/png" ? ".png" : type == "image/x-exr" ? ".exr" : ".bin";
+    if (auto bytes = decodeBase64(data->GetString())) {
+      out.push_back({prefix + member.name.GetString() + extension, std::move(*bytes)});
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<DecodedImage> imagesOf(std::string_view answerJson) {
+  rapidjson::Document root;
+  request::parseJson(answerJson, root);
+  std::vector<DecodedImage> out;
+  if (!root.IsObject()) return out;
+  appendImages(json::find(root, "images"), "", out);
+  if (const json::Value* reference = json::find(root, "reference");
+      reference && reference->IsObject()) {
+    appendImages(json::find(*reference, "images"), "reference_", out);
+  }
+  return out;
 }
 
 }  // namespace limn::api

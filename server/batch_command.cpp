@@ -198,25 +198,18 @@ std::unique_ptr<batch::Executor> remoteExecutor(const Options& o,
   return std::make_unique<RemoteExecutor>(std::move(client), connections);
 }
 
-struct Local {
-  std::unique_ptr<render::oracle::ReferenceSceneCache> cache;
-  std::unique_ptr<WorkerPool> pool;
-};
-
-Local localPool(const api::ServiceConfig& config, int workers) {
-  Local local;
-  local.cache = std::make_unique<render::oracle::ReferenceSceneCache>(config.referenceCacheBytes);
-  PoolOptions options;
-  options.workers = workers > 0 ? workers : config.workers;
+// The render workers of limn serve's configuration: worker processes by default, so that a
+// mesh that crashes one costs its own rows only.
+std::unique_ptr<WorkerPool> localPool(const api::ServiceConfig& config, int workers) {
+  PoolOptions options = poolOptions(config);
+  if (workers > 0) options.workers = workers;
   options.queueDepth = 64;
-  options.timeout = std::chrono::milliseconds(config.requestTimeoutMs);
-  options.referenceCache = local.cache.get();
-  local.pool = std::make_unique<WorkerPool>(options);
-  if (local.pool->snapshot().readyWorkers == 0) {
-    throw Failure{
-        3, "no render worker has an OpenGL context: " + local.pool->workerStatus().front().error};
+  auto pool = std::make_unique<WorkerPool>(options);
+  if (pool->snapshot().readyWorkers == 0) {
+    throw Failure{3,
+                  "no render worker has an OpenGL context: " + pool->workerStatus().front().error};
   }
-  return local;
+  return pool;
 }
 
 // --config FILE, else LIMN_CONFIG (what limn serve reads too: a container sets it once).
@@ -269,13 +262,13 @@ int runBatch(const Options& o, const CLI::App& app) {
   const Clock::time_point start = Clock::now();
   batch::RunSummary summary;
   if (pending > 0) {
-    Local local;
+    std::unique_ptr<WorkerPool> local;
     std::unique_ptr<batch::Executor> executor;
     if (!o.server.empty()) {
       executor = remoteExecutor(o, config);
     } else {
       local = localPool(config, o.workers);
-      executor = std::make_unique<PoolExecutor>(*local.pool, config.limits);
+      executor = std::make_unique<PoolExecutor>(*local);
     }
     std::ofstream results(file, std::ios::app | std::ios::binary);
     if (!results) throw Failure{1, "cannot write " + file.string()};

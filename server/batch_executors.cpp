@@ -1,22 +1,12 @@
 #include "server/batch_executors.h"
 
-#include "api/compare_api.h"
-
 namespace limn::server {
 
-PoolExecutor::PoolExecutor(WorkerPool& pool, const render::pipeline::JobLimits& limits,
-                           int inFlight)
-    : pool_(pool),
-      limits_(limits),
-      inFlight_(inFlight > 0 ? inFlight : static_cast<int>(pool.workerStatus().size())) {}
+PoolExecutor::PoolExecutor(WorkerPool& pool, int inFlight)
+    : pool_(pool), inFlight_(inFlight > 0 ? inFlight : pool.snapshot().workers) {}
 
 batch::Executor::Abandon PoolExecutor::submit(std::string body, Done done) {
-  return pool_.submit(
-      [body = std::move(body), limits = limits_](render::pipeline::RenderContext& context,
-                                                 const render::CancelToken& cancel) {
-        return api::handleCompare(body, limits, context, cancel);
-      },
-      std::move(done));
+  return pool_.submit(Task{Endpoint::Compare, std::move(body)}, std::move(done));
 }
 
 RemoteExecutor::RemoteExecutor(HttpClient client, int connections) : client_(std::move(client)) {

@@ -1,5 +1,5 @@
 // Where the rows of a batch are computed (batch::Executor): PoolExecutor sends each comparison
-// to a WorkerPool through api::handleCompare — the pool `limn batch` starts for itself, or the
+// to a WorkerPool as a /v1/compare Task — the pool `limn batch` starts for itself, or the
 // server's own pool for POST /v1/jobs, with its queue, limits and deadline — and
 // RemoteExecutor sends it to a running server's POST /v1/compare.
 #pragma once
@@ -21,13 +21,12 @@ namespace limn::server {
 class PoolExecutor : public batch::Executor {
  public:
   // `inFlight`: comparisons kept queued or running (0: one per worker).
-  PoolExecutor(WorkerPool& pool, const render::pipeline::JobLimits& limits, int inFlight = 0);
+  explicit PoolExecutor(WorkerPool& pool, int inFlight = 0);
   Abandon submit(std::string body, Done done) override;
   int parallelism() const override { return inFlight_; }
 
  private:
   WorkerPool& pool_;
-  render::pipeline::JobLimits limits_;
   int inFlight_;
 };
 

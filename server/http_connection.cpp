@@ -92,6 +92,8 @@ void Connection::readHeader() {
 void Connection::onHeader(error_code ec) {
   requestStart_ = Clock::now();
   if (parser_->is_header_done()) {
+    // Numbered now, so that a worker that dies on this request can name it in the answer.
+    requestId_ = shared_.router.log().nextId();
     const auto& request = parser_->get();
     version_ = request.version();
     route_ = Router::routeLabel(std::string_view(request.target().data(), request.target().size()));
@@ -142,7 +144,8 @@ void Connection::handle() {
                   std::move(message.body()),
                   std::string(message[http::field::accept]),
                   std::string(message[http::field::authorization]),
-                  std::string(message[http::field::origin])};
+                  std::string(message[http::field::origin]),
+                  requestId_};
   // The router may answer from a worker thread: hop back onto this connection's strand.
   const unsigned generation = ++handling_;
   abandon_ = shared_.router.handle(
@@ -182,7 +185,9 @@ void Connection::answer(api::Answer answer, bool close) {
   response.set(http::field::server, "limn/" LIMN_VERSION);
   response.set(http::field::content_type, answer.contentType);
   for (const auto& [name, value] : answer.headers) response.set(name, value);
-  const uint64_t id = shared_.router.log().nextId();
+  // An answer before a header was read (a refused connection) gets its number here.
+  const uint64_t id = requestId_ ? requestId_ : shared_.router.log().nextId();
+  requestId_ = 0;
   response.set("X-Request-Id", std::to_string(id));
   response.keep_alive(!close);
   const size_t bytesOut = answer.body.size();

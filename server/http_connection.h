@@ -120,6 +120,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   size_t bytesIn_ = 0;        // its body
   std::chrono::steady_clock::time_point requestStart_;
   char drainBuffer_[4096];
+  uint64_t requestId_ = 0;       // of the request being read or answered (X-Request-Id)
   WorkerPool::Abandon abandon_;  // the job of the request being handled, while it runs
   unsigned handling_ = 0;        // counts handle() calls: a stale watch sees another number
 };

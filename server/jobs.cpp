@@ -177,7 +177,7 @@ void JobManager::driverLoop() {
 
 void JobManager::runJob(Job& job) {
   const std::vector<api::RowGroup> groups = job.plan.pendingGroups({}, {}, limits_.maxCompareRows);
-  PoolExecutor executor(pool_, limits_);
+  PoolExecutor executor(pool_);
   batch::RunCallbacks callbacks;
   callbacks.rows = [&](const api::RowGroup&, const std::vector<std::string>& lines) {
     std::lock_guard lock(mutex_);

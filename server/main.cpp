@@ -26,7 +26,9 @@
 #include "server/batch_command.h"
 #include "server/http_server.h"
 #include "server/router.h"
+#include "server/tasks.h"
 #include "server/worker_pool.h"
+#include "server/worker_process.h"
 
 #ifndef LIMN_VERSION
 #define LIMN_VERSION "unknown"
@@ -193,24 +195,22 @@ int serve(const CommandLine& cl) {
     if (config->workers < 0) return usageError("--workers must be 0 (one per core) or more");
   }
 
-  server::PoolOptions poolOptions;
-  poolOptions.workers = config->workers;
-  poolOptions.queueDepth = config->queueDepth;
-  poolOptions.timeout = std::chrono::milliseconds(config->requestTimeoutMs);
-  render::oracle::ReferenceSceneCache referenceCache(config->referenceCacheBytes);
-  poolOptions.referenceCache = &referenceCache;
+  render::mesh::MeshCache meshCache(config->meshCacheBytes);
   server::ServiceMetrics metrics;
+  server::PoolOptions poolOptions = server::poolOptions(*config);
+  poolOptions.meshes = &meshCache;
   poolOptions.metrics = &metrics;
   server::WorkerPool pool(poolOptions);
-  for (size_t i = 0; i < pool.workerStatus().size(); ++i) {
-    const auto& w = pool.workerStatus()[i];
-    if (!w.ready)
-      std::cerr << "limn: worker " << i << " has no OpenGL context: " << w.error << "\n";
+  const std::vector<server::WorkerStatus> workers = pool.workerStatus();
+  for (size_t i = 0; i < workers.size(); ++i) {
+    if (!workers[i].ready)
+      std::cerr << "limn: worker " << i << " has no OpenGL context: " << workers[i].error << "\n";
   }
-  if (!pool.workerStatus().empty() && pool.workerStatus().front().ready) {
-    const auto& device = pool.workerStatus().front().device;
-    std::cerr << "limn: " << pool.workerStatus().size() << " render workers on " << device.renderer
-              << " (EGL " << device.eglPlatform << ")\n";
+  if (!workers.empty() && workers.front().ready) {
+    std::cerr << "limn: " << workers.size() << " render workers ("
+              << (poolOptions.isolation == server::Isolation::Process ? "processes" : "threads")
+              << ") on " << workers.front().device.renderer << " (EGL "
+              << workers.front().device.eglPlatform << ")\n";
   }
 
   server::AccessOptions access{config->authToken, config->corsOrigins};
@@ -218,7 +218,6 @@ int serve(const CommandLine& cl) {
     if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token)
       access.authToken = token;
   }
-  render::mesh::MeshCache meshCache(config->meshCacheBytes);
   server::JobManager jobs(
       pool, config->limits,
       {config->maxJobs, config->maxJobRows, std::chrono::seconds(config->jobRetentionSeconds)},
@@ -275,64 +274,45 @@ int renderCommand(const CommandLine& cl) {
   auto text = readFile(cl.positional[0]);
   if (!text) return usageError("cannot read " + cl.positional[0]);
 
-  // The same command takes /v1/render's body and /v1/implicit's (which has a "field").
-  const bool implicit = api::isImplicitRequest(*text);
-  api::RenderRequest request;
-  api::ImplicitRequest implicitRequest;
-  try {
-    if (implicit) {
-      implicitRequest = api::parseImplicitRequest(*text, config->limits);
-      request.imageFormat = implicitRequest.imageFormat;
-    } else {
-      request = api::parseRenderRequest(*text, config->limits);
-    }
-  } catch (const api::ApiError& e) {
-    return fail(e, 2);
-  }
-
-  std::optional<render::pipeline::RenderResult> result;  // RenderResult has no empty state
+  // The same command takes /v1/render's body and /v1/implicit's (which has a "field"), and
+  // runs it through the same handler as the server.
+  const server::Task task{
+      api::isImplicitRequest(*text) ? server::Endpoint::Implicit : server::Endpoint::Render,
+      std::move(*text)};
+  api::Answer answer;
   try {
     render::raster::Rasterizer rasterizer;
     render::pipeline::RenderContext context;
     context.rasterizer = &rasterizer;
-    result = implicit ? render::pipeline::runImplicit(implicitRequest.job, config->limits, context,
-                                                      render::CancelToken{})
-                      : render::pipeline::run(request.job, config->limits, context,
-                                              render::CancelToken{});
-  } catch (const render::InputError& e) {
-    return fail(api::fromInputError(e), 2);
+    answer = server::runTask(task, config->limits, context, render::CancelToken{}, nullptr);
   } catch (const std::exception& e) {
-    return fail({500, "internal", std::string("render failed: ") + e.what()}, 3);
+    return fail({500, "internal", e.what()}, 3);
   }
-
+  if (answer.status != 200) {
+    std::cerr << answer.body << "\n";
+    return answer.status < 500 ? 2 : 3;
+  }
   try {
     std::filesystem::path dir(*cl.out);
     std::filesystem::create_directories(dir);
-    std::string json =
-        implicit ? api::writeRenderResponse(
-                       *result, api::AnswerShape{.outputs = implicitRequest.job.outputs,
-                                                 .reference = implicitRequest.job.reference,
-                                                 .imageFormat = implicitRequest.imageFormat,
-                                                 .warnings = implicitRequest.warnings})
-                 : api::writeRenderResponse(*result, request);
-    writeFile(dir / "response.json", json.data(), json.size());
-    std::vector<std::string> written{(dir / "response.json").string()};
-    auto writeSet = [&](const render::ImageSet& set, const std::string& prefix) {
-      for (const auto& [name, image] : set.passes) {
-        auto encoded = render::image::encode(image, name, request.imageFormat);
-        const char* ext = request.imageFormat == render::image::Format::Exr ? ".exr" : ".png";
-        auto path = dir / (prefix + name + ext);
-        writeFile(path, encoded.bytes.data(), encoded.bytes.size());
-        written.push_back(path.string());
-      }
-    };
-    writeSet(result->images, "");
-    if (result->referenceImages) writeSet(*result->referenceImages, "reference_");
-    for (const auto& path : written) std::cout << path << "\n";
+    writeFile(dir / "response.json", answer.body.data(), answer.body.size());
+    std::cout << (dir / "response.json").string() << "\n";
+    for (const api::DecodedImage& image : api::imagesOf(answer.body)) {
+      const auto path = dir / image.fileName;
+      writeFile(path, image.bytes.data(), image.bytes.size());
+      std::cout << path.string() << "\n";
+    }
   } catch (const std::exception& e) {
     return fail({500, "internal", e.what()}, 3);
   }
   return 0;
+}
+
+// limn worker --fd N: a render worker process, started by limn serve (server/worker_process.h);
+// not for people to run.
+int workerCommand(int argc, char** argv) {
+  if (argc != 4 || std::string(argv[2]) != "--fd") return usageError("worker is started by serve");
+  return server::workerMain(std::atoi(argv[3]));
 }
 
 }  // namespace
@@ -356,6 +336,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (command == "batch") return server::batchCommand(argc, argv);
+  if (command == "worker") return workerCommand(argc, argv);
   if (command != "serve" && command != "render") return usageError("unknown command " + command);
 
   std::string error;

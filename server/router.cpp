@@ -1,15 +1,16 @@
 #include "server/router.h"
 
+#include <rapidjson/stringbuffer.h>
+#include <rapidjson/writer.h>
+
 #include <cstdio>
 #include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
 
-#include "api/compare_api.h"
-#include "api/implicit_api.h"
+#include "api/json_util.h"
 #include "api/openapi.h"
-#include "api/silhouette_api.h"
 #include "server/web_assets.h"
 
 #ifndef LIMN_VERSION
@@ -18,25 +19,36 @@
 
 namespace limn::server {
 
+// One entry of the route table: a request with this method and path goes to `handler`; a known
+// path with another method is a 405 listing the methods it has.
+struct Router::Route {
+  std::string_view method;
+  std::string_view path;  // "{id}" stands for one path segment
+  Handler handler;
+  Endpoint endpoint = Endpoint::Render;  // for Router::compute
+};
+
+const Router::Route Router::kRoutes[] = {
+    {"GET", "/healthz", &Router::healthz},
+    {"GET", "/readyz", &Router::readyz},
+    {"GET", "/metrics", &Router::metricsText},
+    {"GET", "/openapi.json", &Router::openApi},
+    {"POST", "/v1/render", &Router::compute, Endpoint::Render},
+    {"POST", "/v1/silhouette", &Router::compute, Endpoint::Silhouette},
+    {"POST", "/v1/tessellate", &Router::compute, Endpoint::Tessellate},
+    {"POST", "/v1/implicit", &Router::compute, Endpoint::Implicit},
+    {"POST", "/v1/compare", &Router::compute, Endpoint::Compare},
+    {"POST", "/v1/meshes", &Router::uploadMesh},
+    {"POST", "/v1/jobs", &Router::createJob},
+    {"GET", "/v1/jobs/{id}", &Router::getJob},
+    {"DELETE", "/v1/jobs/{id}", &Router::cancelJob},
+};
+
 namespace {
-
-struct Route {
-  const char* path;
-  const char* method;
-};
-
-// Every (path, method) limn answers; a known path with another method is a 405 listing these.
-constexpr Route kRoutes[] = {
-    {"/healthz", "GET"},         {"/readyz", "GET"},         {"/metrics", "GET"},
-    {"/openapi.json", "GET"},    {"/v1/render", "POST"},     {"/v1/silhouette", "POST"},
-    {"/v1/meshes", "POST"},      {"/v1/tessellate", "POST"}, {"/v1/implicit", "POST"},
-    {"/v1/compare", "POST"},     {"/v1/jobs", "POST"},       {"/v1/jobs/{id}", "GET"},
-    {"/v1/jobs/{id}", "DELETE"},
-};
 
 constexpr std::string_view kJobPrefix = "/v1/jobs/";
 
-// The path as kRoutes names it: /v1/jobs/<id> is "/v1/jobs/{id}".
+// The path as the route table names it: /v1/jobs/<id> is "/v1/jobs/{id}".
 std::string_view routePath(std::string_view path) {
   if (path.size() > kJobPrefix.size() && path.substr(0, kJobPrefix.size()) == kJobPrefix &&
       path.find('/', kJobPrefix.size()) == std::string_view::npos) {
@@ -61,45 +73,21 @@ size_t offsetParameter(std::string_view target) {
   return value;
 }
 
-// The few JSON strings the service endpoints write (renderer names, error texts) go through
-// this; the request and response documents themselves belong to api/.
-std::string jsonString(std::string_view text) {
-  std::string out = "\"";
-  for (char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
 api::Answer jsonAnswer(int status, std::string body) {
   api::Answer answer;
   answer.status = status;
   answer.body = std::move(body);
   return answer;
+}
+
+// Answers at once; the handlers that do have no job to abandon.
+WorkerPool::Abandon answerNow(Router::Reply& reply, api::Answer answer) {
+  reply(std::move(answer));
+  return {};
+}
+
+std::string jobId(const Request& request) {
+  return std::string(pathOf(request.target).substr(kJobPrefix.size()));
 }
 
 }  // namespace
@@ -139,69 +127,37 @@ WorkerPool::Abandon Router::handle(Request request, Reply reply) {
   }
   std::string_view path = pathOf(request.target);
   if (request.method == "OPTIONS" && routeLabel(path) != "other") {
-    if (auto preflight = access_.preflight(request.origin)) {
-      reply(std::move(*preflight));
-      return {};
-    }
+    if (auto preflight = access_.preflight(request.origin)) return answerNow(reply, *preflight);
   }
   if (auto refusal = access_.refuse(path, request.authorization)) {
-    reply(std::move(*refusal));
-    return {};
+    return answerNow(reply, std::move(*refusal));
   }
   return route(std::move(request), std::move(reply));
 }
 
 WorkerPool::Abandon Router::route(Request request, Reply reply) {
-  const std::string target = request.target;
-  std::string_view path = pathOf(target);
-  std::vector<std::string> allowed;
+  const std::string_view path = pathOf(request.target);
+  const std::string_view routed = routePath(path);
+  std::string allow;
   for (const Route& route : kRoutes) {
-    if (routePath(path) == route.path) allowed.emplace_back(route.method);
+    if (route.path != routed) continue;
+    if (route.method == request.method) return (this->*route.handler)(route, request, reply);
+    allow += (allow.empty() ? "" : ", ") + std::string(route.method);
   }
   const EmbeddedFile* asset = findWebAsset(path);
-  if (asset) allowed.emplace_back("GET");
-  if (allowed.empty()) {
-    reply(api::errorAnswer({404, "not_found", "no such endpoint: " + std::string(path),
-                            "{\"path\":" + jsonString(path) + "}"}));
-    return {};
+  if (asset && request.method == "GET") return answerNow(reply, webAsset(*asset));
+  if (asset) allow = "GET";
+  if (allow.empty()) {
+    return answerNow(reply,
+                     api::errorAnswer({404, "not_found", "no such endpoint: " + std::string(path),
+                                       api::json::detailObject({{"path", std::string(path)}})}));
   }
-  bool methodAllowed = false;
-  for (const auto& m : allowed) methodAllowed = methodAllowed || m == request.method;
-  if (!methodAllowed) {
-    std::string allow;
-    for (const auto& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
-    api::Answer answer = api::errorAnswer(
-        {405, "method_not_allowed",
-         request.method + " is not allowed on " + std::string(path) + "; use " + allow,
-         "{\"allow\":" + jsonString(allow) + "}"});
-    answer.headers.emplace_back("Allow", allow);
-    reply(std::move(answer));
-    return {};
-  }
-
-  std::optional<api::Answer> now;
-  if (asset) now = webAsset(*asset);
-  if (path == "/healthz") now = healthz();
-  if (path == "/readyz") now = readyz();
-  if (path == "/metrics") now = metricsAnswer();
-  if (path == "/openapi.json") now = jsonAnswer(200, std::string(api::openApiDocument()));
-  if (now) {
-    reply(std::move(*now));
-    return {};
-  }
-  if (path == "/v1/silhouette") {
-    return silhouette(std::move(request.body), std::move(request.accept), std::move(reply));
-  }
-  if (path == "/v1/meshes") return uploadMesh(std::move(request.body), std::move(reply));
-  if (path == "/v1/compare") return compare(std::move(request.body), std::move(reply));
-  if (routePath(path) != path || path == "/v1/jobs") return jobs(request, std::move(reply));
-  if (path == "/v1/tessellate") {
-    return tessellate(std::move(request.body), std::move(request.accept), std::move(reply));
-  }
-  if (path == "/v1/implicit") {
-    return implicit(std::move(request.body), std::move(request.accept), std::move(reply));
-  }
-  return render(std::move(request.body), std::move(reply));
+  api::Answer answer = api::errorAnswer(
+      {405, "method_not_allowed",
+       request.method + " is not allowed on " + std::string(path) + "; use " + allow,
+       api::json::detailObject({{"allow", allow}})});
+  answer.headers.emplace_back("Allow", allow);
+  return answerNow(reply, std::move(answer));
 }
 
 // The page and the examples: small and built in, answered on the IO thread. no-cache makes a
@@ -214,126 +170,126 @@ api::Answer Router::webAsset(const EmbeddedFile& file) const {
   return answer;
 }
 
-// Parsing a large mesh takes a while: it runs on a worker like a render (same queue, limits and
-// deadline), though it needs no GL context.
-WorkerPool::Abandon Router::uploadMesh(std::string body, Reply reply) {
+WorkerPool::Abandon Router::compute(const Route& route, Request& request, Reply& reply) {
+  return pool_.submit(Task{route.endpoint, std::move(request.body), std::move(request.accept)},
+                      std::move(reply), request.id);
+}
+
+// Parsing a large mesh takes a while: it runs on a worker's thread like a render (same queue,
+// limits and deadline), in the server, whose cache keeps the mesh.
+WorkerPool::Abandon Router::uploadMesh(const Route&, Request& request, Reply& reply) {
   if (!meshes_) {
-    reply(api::errorAnswer(
-        {404, "not_found", "this server keeps no uploaded meshes", "{\"path\":\"/v1/meshes\"}"}));
-    return {};
+    return answerNow(reply,
+                     api::errorAnswer({404, "not_found", "this server keeps no uploaded meshes",
+                                       api::json::detailObject({{"path", "/v1/meshes"}})}));
   }
-  return pool_.submit(
-      [body = std::move(body), limits = limits_, meshes = meshes_](render::pipeline::RenderContext&,
-                                                                   const render::CancelToken&) {
+  return pool_.submitInServer(
+      [body = std::move(request.body), limits = limits_, meshes = meshes_](
+          render::pipeline::RenderContext&, const render::CancelToken&) {
         return api::handleMeshUpload(body, limits, *meshes);
       },
       std::move(reply));
 }
 
-// The approximation's mesh for a client that draws it itself: the method's work without the
-// raster, on the same workers.
-WorkerPool::Abandon Router::tessellate(std::string body, std::string accept, Reply reply) {
-  return pool_.submit(
-      [body = std::move(body), accept = std::move(accept), limits = limits_, meshes = meshes_](
-          render::pipeline::RenderContext&, const render::CancelToken& cancel) {
-        return api::handleTessellate(body, accept, limits, cancel, meshes);
-      },
-      std::move(reply));
+// A job's spec (its meshes) is read on a worker's thread, like an upload; its state and
+// cancellation are answered at once. The rows themselves go through the pool as comparisons
+// (server/jobs.h).
+WorkerPool::Abandon Router::createJob(const Route&, Request& request, Reply& reply) {
+  if (!jobs_) return getJob(kRoutes[0], request, reply);  // the same 404
+  return pool_.submitInServer([jobs = jobs_, body = std::move(request.body)](
+                                  render::pipeline::RenderContext&,
+                                  const render::CancelToken&) { return jobs->create(body); },
+                              std::move(reply));
 }
 
-WorkerPool::Abandon Router::render(std::string body, Reply reply) {
-  return pool_.submit(
-      [body = std::move(body), limits = limits_, meshes = meshes_](
-          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
-        return api::handleRender(body, limits, context, cancel, meshes);
-      },
-      std::move(reply));
-}
-
-// Implicit scenes: polygonised, drawn and measured on the same workers as meshes.
-WorkerPool::Abandon Router::implicit(std::string body, std::string accept, Reply reply) {
-  return pool_.submit(
-      [body = std::move(body), accept = std::move(accept), limits = limits_](
-          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
-        return api::handleImplicit(body, accept, limits, context, cancel);
-      },
-      std::move(reply));
-}
-
-// Several methods against one reference per camera: one job on one worker (the request's
-// deadline covers all of its rows).
-WorkerPool::Abandon Router::compare(std::string body, Reply reply) {
-  return pool_.submit(
-      [body = std::move(body), limits = limits_, meshes = meshes_](
-          render::pipeline::RenderContext& context, const render::CancelToken& cancel) {
-        return api::handleCompare(body, limits, context, cancel, meshes);
-      },
-      std::move(reply));
-}
-
-// A job's spec (its meshes) is read on a worker, like an upload; its state and cancellation are
-// answered at once. The rows themselves go through the pool as comparisons (server/jobs.h).
-WorkerPool::Abandon Router::jobs(const Request& request, Reply reply) {
-  std::string_view path = pathOf(request.target);
+WorkerPool::Abandon Router::getJob(const Route&, Request& request, Reply& reply) {
   if (!jobs_) {
-    reply(api::errorAnswer(
-        {404, "not_found", "this server runs no jobs", "{\"path\":" + jsonString(path) + "}"}));
-    return {};
+    const std::string path(pathOf(request.target));
+    return answerNow(reply, api::errorAnswer({404, "not_found", "this server runs no jobs",
+                                              api::json::detailObject({{"path", path}})}));
   }
-  if (path == "/v1/jobs") {
-    return pool_.submit([jobs = jobs_, body = request.body](
-                            render::pipeline::RenderContext&,
-                            const render::CancelToken&) { return jobs->create(body); },
-                        std::move(reply));
-  }
-  const std::string id(path.substr(kJobPrefix.size()));
-  reply(request.method == "DELETE" ? jobs_->cancel(id)
-                                   : jobs_->get(id, offsetParameter(request.target)));
-  return {};
+  if (request.method == "POST") return {};  // unreachable: createJob handles it
+  return answerNow(reply, jobs_->get(jobId(request), offsetParameter(request.target)));
 }
 
-// Contours need no GL context, but share the render workers: one queue, one set of limits and
-// deadlines for everything that computes.
-WorkerPool::Abandon Router::silhouette(std::string body, std::string accept, Reply reply) {
-  return pool_.submit(
-      [body = std::move(body), accept = std::move(accept), limits = limits_, meshes = meshes_](
-          render::pipeline::RenderContext&, const render::CancelToken& cancel) {
-        return api::handleSilhouette(body, accept, limits, cancel, meshes);
-      },
-      std::move(reply));
+WorkerPool::Abandon Router::cancelJob(const Route& route, Request& request, Reply& reply) {
+  if (!jobs_) return getJob(route, request, reply);
+  return answerNow(reply, jobs_->cancel(jobId(request)));
 }
 
-api::Answer Router::healthz() const {
+WorkerPool::Abandon Router::openApi(const Route&, Request&, Reply& reply) {
+  return answerNow(reply, jsonAnswer(200, std::string(api::openApiDocument())));
+}
+
+WorkerPool::Abandon Router::healthz(const Route&, Request&, Reply& reply) {
   PoolSnapshot pool = pool_.snapshot();
-  const auto& workers = pool_.workerStatus();
+  const std::vector<WorkerStatus> workers = pool_.workerStatus();
 
   // Every worker runs the same driver; report the first one that has a context, and the
   // errors of those that do not.
   const render::raster::DeviceInfo* device = nullptr;
-  std::string errors;
   for (const auto& w : workers) {
     if (w.ready && !device) device = &w.device;
-    if (!w.ready) errors += (errors.empty() ? "" : ",") + jsonString(w.error);
   }
-  bool ok = pool.readyWorkers == pool.workers && !pool.stopping;
-  double uptime =
+  const bool ok = pool.readyWorkers == pool.workers && !pool.stopping;
+  const double uptime =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  size_t crashes = 0;
+  for (const auto& [signal, count] : pool.crashes) crashes += count;
 
-  std::ostringstream out;
-  out << "{\"status\":" << jsonString(ok ? "ok" : "degraded")
-      << ",\"version\":" << jsonString(LIMN_VERSION)
-      << ",\"renderer\":" << jsonString(device ? device->renderer : "")
-      << ",\"glVendor\":" << jsonString(device ? device->vendor : "")
-      << ",\"glVersion\":" << jsonString(device ? device->version : "")
-      << ",\"eglPlatform\":" << jsonString(device ? device->eglPlatform : "")
-      << ",\"workers\":" << pool.workers << ",\"readyWorkers\":" << pool.readyWorkers
-      << ",\"busyWorkers\":" << pool.busyWorkers << ",\"queueDepth\":" << pool.queued
-      << ",\"queueCapacity\":" << pool.queueCapacity << ",\"uptimeS\":" << uptime << ",\"errors\":["
-      << errors << "]}";
-  return jsonAnswer(200, out.str());
+  rapidjson::StringBuffer buffer;
+  api::json::Writer out(buffer);
+  auto string = [&](const char* key, std::string_view value) {
+    out.Key(key);
+    out.String(value.data(), static_cast<rapidjson::SizeType>(value.size()));
+  };
+  auto integer = [&](const char* key, int64_t value) {
+    out.Key(key);
+    out.Int64(value);
+  };
+  out.StartObject();
+  string("status", ok ? "ok" : "degraded");
+  string("version", LIMN_VERSION);
+  string("renderer", device ? device->renderer : "");
+  string("glVendor", device ? device->vendor : "");
+  string("glVersion", device ? device->version : "");
+  string("eglPlatform", device ? device->eglPlatform : "");
+  string("workerIsolation", pool_.options().isolation == Isolation::Process ? "process" : "thread");
+  integer("workers", pool.workers);
+  integer("readyWorkers", pool.readyWorkers);
+  integer("busyWorkers", pool.busyWorkers);
+  integer("queueDepth", static_cast<int64_t>(pool.queued));
+  integer("queueCapacity", static_cast<int64_t>(pool.queueCapacity));
+  integer("workerStarts", static_cast<int64_t>(pool.workerStarts));
+  integer("workerCrashes", static_cast<int64_t>(crashes));
+  out.Key("uptimeS");
+  out.Double(uptime);
+  out.Key("workerStates");
+  out.StartArray();
+  for (const auto& w : workers) {
+    out.StartObject();
+    integer("pid", w.pid);
+    // "starting": a replacement on its way; "failed": no GL context, or it would not start.
+    string("state", w.ready ? (w.busy ? "busy" : "idle") : w.error.empty() ? "starting" : "failed");
+    integer("starts", static_cast<int64_t>(w.starts));
+    if (w.busy) {
+      string("endpoint", w.endpoint);
+      integer("requestId", static_cast<int64_t>(w.requestId));
+    }
+    out.EndObject();
+  }
+  out.EndArray();
+  out.Key("errors");
+  out.StartArray();
+  for (const auto& w : workers) {
+    if (!w.ready && !w.error.empty()) out.String(w.error.c_str());
+  }
+  out.EndArray();
+  out.EndObject();
+  return answerNow(reply, jsonAnswer(200, buffer.GetString()));
 }
 
-api::Answer Router::readyz() const {
+WorkerPool::Abandon Router::readyz(const Route&, Request&, Reply& reply) {
   PoolSnapshot pool = pool_.snapshot();
   std::string reason;
   if (pool.stopping) {
@@ -343,11 +299,12 @@ api::Answer Router::readyz() const {
   } else if (pool.queued >= pool.queueCapacity) {
     reason = "render queue full";
   }
-  if (reason.empty()) return jsonAnswer(200, "{\"ready\":true}");
-  return jsonAnswer(503, "{\"ready\":false,\"reason\":" + jsonString(reason) + "}");
+  if (reason.empty()) return answerNow(reply, jsonAnswer(200, "{\"ready\":true}"));
+  return answerNow(reply, jsonAnswer(503, "{\"ready\":false,\"reason\":" +
+                                              api::json::quote(reason, reason.size()) + "}"));
 }
 
-api::Answer Router::metricsAnswer() const {
+WorkerPool::Abandon Router::metricsText(const Route&, Request&, Reply& reply) {
   PoolSnapshot pool = pool_.snapshot();
   std::ostringstream out;
   out << metrics_.text();
@@ -357,7 +314,7 @@ api::Answer Router::metricsAnswer() const {
       << "# HELP limn_queue_capacity Render jobs that may wait before requests get 429.\n"
          "# TYPE limn_queue_capacity gauge\n"
       << "limn_queue_capacity " << pool.queueCapacity << "\n"
-      << "# HELP limn_workers Render worker threads, by whether they hold a GL context.\n"
+      << "# HELP limn_workers Render workers, by whether they hold a GL context.\n"
          "# TYPE limn_workers gauge\n"
       << "limn_workers{state=\"ready\"} " << pool.readyWorkers << "\n"
       << "limn_workers{state=\"failed\"} " << pool.workers - pool.readyWorkers << "\n"
@@ -369,9 +326,19 @@ api::Answer Router::metricsAnswer() const {
       << "limn_render_jobs_refused_total{reason=\"busy\"} " << pool.rejectedBusy << "\n"
       << "limn_render_jobs_refused_total{reason=\"timeout\"} " << pool.timedOut << "\n"
       << "limn_render_jobs_refused_total{reason=\"shutdown\"} " << pool.cancelled << "\n"
-      << "limn_render_jobs_refused_total{reason=\"abandoned\"} " << pool.abandoned << "\n";
-  if (const render::oracle::ReferenceSceneCache* cache = pool_.options().referenceCache) {
-    render::oracle::ReferenceSceneCache::Counters c = cache->counters();
+      << "limn_render_jobs_refused_total{reason=\"abandoned\"} " << pool.abandoned << "\n"
+      << "# HELP limn_worker_starts_total Render worker processes started (the first ones and "
+         "their replacements).\n"
+         "# TYPE limn_worker_starts_total counter\n"
+      << "limn_worker_starts_total " << pool.workerStarts << "\n"
+      << "# HELP limn_worker_crashes_total Render worker processes lost while running a request, "
+         "by the signal that ended them (\"exit\": none), each replaced at once.\n"
+         "# TYPE limn_worker_crashes_total counter\n";
+  for (const auto& [signal, count] : pool.crashes) {
+    out << "limn_worker_crashes_total{signal=\"" << signal << "\"} " << count << "\n";
+  }
+  {
+    const render::oracle::ReferenceSceneCache::Counters& c = pool.referenceCache;
     out << "# HELP limn_reference_cache_lookups_total Reference scene lookups, by result.\n"
            "# TYPE limn_reference_cache_lookups_total counter\n"
         << "limn_reference_cache_lookups_total{result=\"hit\"} " << c.hits << "\n"
@@ -395,7 +362,7 @@ api::Answer Router::metricsAnswer() const {
   answer.status = 200;
   answer.contentType = "text/plain; version=0.0.4; charset=utf-8";
   answer.body = out.str();
-  return answer;
+  return answerNow(reply, std::move(answer));
 }
 
 }  // namespace limn::server

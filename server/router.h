@@ -1,21 +1,19 @@
 // Router: what limn does with one HTTP request, with no socket in sight.
 //
-// The HTTP layer hands it (method, target, body) and a reply callback; the router answers the
-// service endpoints at once (/healthz, /readyz, /metrics, /openapi.json), sends renders to the
-// WorkerPool, and answers 404/405 JSON for everything else; access.h's rules (bearer token,
-// CORS) come first. Tests call it directly.
+// The HTTP layer hands it (method, target, body) and a reply callback; the router finds the
+// request's entry in one route table (router.cpp: {method, path, handler}), answers the service
+// endpoints at once (/healthz, /readyz, /metrics, /openapi.json), sends the computing ones to
+// the WorkerPool as Tasks (server/tasks.h), and answers 404/405 JSON for everything else;
+// access.h's rules (bearer token, CORS) come first. Tests call it directly.
 //
-//   GET  /healthz       liveness and what the workers run on
+//   GET  /healthz       liveness, what the workers run on, each worker's state
 //   GET  /readyz        200 when a render would be accepted now, else 503
 //   GET  /metrics       Prometheus text format
 //   GET  /openapi.json  the API description
-//   POST /v1/render     api::handleRender on a worker thread
-//   POST /v1/silhouette api::handleSilhouette on a worker thread (same queue, limits, timeout)
-//   POST /v1/meshes     api::handleMeshUpload on a worker thread, into the MeshCache
-//   POST /v1/tessellate api::handleTessellate on a worker thread (the mesh, no raster)
-//   POST /v1/implicit   api::handleImplicit on a worker thread (an implicit field's scene)
-//   POST /v1/compare    api::handleCompare on a worker thread (methods x cameras, one job)
-//   POST /v1/jobs       JobManager::create on a worker thread (a batch spec, run in the back)
+//   POST /v1/render, /v1/silhouette, /v1/tessellate, /v1/implicit, /v1/compare
+//                       a Task on a render worker (one queue, one set of limits and deadlines)
+//   POST /v1/meshes     api::handleMeshUpload on a worker's thread in the server, into the cache
+//   POST /v1/jobs       JobManager::create on a worker's thread in the server
 //   GET, DELETE /v1/jobs/{id}   JobManager::get / cancel, at once
 //   GET  /, /NAME.js, /examples, /examples/NAME   the built-in page and examples (web_assets.h)
 #pragma once
@@ -44,6 +42,7 @@ struct Request {
   std::string accept = {};  // the Accept header ("" when absent): /v1/silhouette may answer SVG
   std::string authorization = {};  // the Authorization header ("" when absent)
   std::string origin = {};         // the Origin header ("" when absent)
+  uint64_t id = 0;                 // the X-Request-Id its answer will carry
 };
 
 class Router {
@@ -65,21 +64,27 @@ class Router {
   // The label a request's path gets in /metrics: the path when limn serves it, else "other".
   static std::string routeLabel(std::string_view target);
 
+  struct Route;
+
   // The HTTP layer records every answer it writes here.
   ServiceMetrics& metrics() { return metrics_; }
   RequestLog& log() { return log_; }
 
  private:
-  api::Answer healthz() const;
-  api::Answer readyz() const;
-  api::Answer metricsAnswer() const;
-  WorkerPool::Abandon render(std::string body, Reply reply);
-  WorkerPool::Abandon silhouette(std::string body, std::string accept, Reply reply);
-  WorkerPool::Abandon uploadMesh(std::string body, Reply reply);
-  WorkerPool::Abandon tessellate(std::string body, std::string accept, Reply reply);
-  WorkerPool::Abandon implicit(std::string body, std::string accept, Reply reply);
-  WorkerPool::Abandon compare(std::string body, Reply reply);
-  WorkerPool::Abandon jobs(const Request& request, Reply reply);
+  // Every handler of the route table has this shape; those answering at once return {}.
+  using Handler = WorkerPool::Abandon (Router::*)(const Route&, Request&, Reply&);
+  static const Route kRoutes[];
+
+  WorkerPool::Abandon healthz(const Route&, Request&, Reply& reply);
+  WorkerPool::Abandon readyz(const Route&, Request&, Reply& reply);
+  WorkerPool::Abandon metricsText(const Route&, Request&, Reply& reply);
+  WorkerPool::Abandon openApi(const Route&, Request&, Reply& reply);
+  // The route's Endpoint as a Task for the workers.
+  WorkerPool::Abandon compute(const Route& route, Request& request, Reply& reply);
+  WorkerPool::Abandon uploadMesh(const Route&, Request& request, Reply& reply);
+  WorkerPool::Abandon createJob(const Route&, Request& request, Reply& reply);
+  WorkerPool::Abandon getJob(const Route&, Request& request, Reply& reply);
+  WorkerPool::Abandon cancelJob(const Route&, Request& request, Reply& reply);
   api::Answer webAsset(const EmbeddedFile& file) const;
 
   WorkerPool::Abandon route(Request request, Reply reply);

@@ -1,6 +1,7 @@
 #include "server/worker_pool.h"
 
 #include <malloc.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,10 +14,18 @@ namespace limn::server {
 using Clock = render::CancelToken::Clock;
 
 struct WorkerPool::Job {
-  Job(Work w, Reply r, Clock::time_point due)
-      : work(std::move(w)), reply(std::move(r)), queued(Clock::now()), deadline(due), token(due) {}
+  Job(Task t, Work w, uint64_t id, Reply r, Clock::time_point due)
+      : task(std::move(t)),
+        work(std::move(w)),
+        requestId(id),
+        reply(std::move(r)),
+        queued(Clock::now()),
+        deadline(due),
+        token(due) {}
 
-  Work work;
+  Task task;
+  Work work;  // set: run in the server (submitInServer); else `task` is the engine's
+  uint64_t requestId;
   Reply reply;
   Clock::time_point queued, deadline;
   render::CancelToken token;
@@ -46,36 +55,65 @@ api::Answer unavailableAnswer(const std::string& why) {
   return answer;
 }
 
+api::Answer crashAnswer(const WorkerProcess::Outcome& outcome, int pid, uint64_t requestId) {
+  std::string detail = "{\"pid\":" + std::to_string(pid) +
+                       ",\"requestId\":" + std::to_string(requestId) + ",\"signal\":\"" +
+                       outcome.signal + "\"}";
+  return api::errorAnswer({500, "worker_crashed",
+                           "the render worker (pid " + std::to_string(pid) + ") running request " +
+                               std::to_string(requestId) + " " + outcome.crash +
+                               "; the request is not retried, the worker has been replaced",
+                           detail});
+}
+
+// How long a slot waits before it tries again to start a worker that would not start.
+constexpr std::chrono::seconds kRestartBackoff{1};
+
 }  // namespace
+
+PoolOptions poolOptions(const api::ServiceConfig& config) {
+  PoolOptions options;
+  options.workers = config.workers;
+  options.queueDepth = static_cast<size_t>(config.queueDepth);
+  options.timeout = std::chrono::milliseconds(config.requestTimeoutMs);
+  options.isolation = config.workerIsolation == "thread" ? Isolation::Thread : Isolation::Process;
+  options.limits = config.limits;
+  options.referenceCacheBytes = config.referenceCacheBytes;
+  return options;
+}
+
+size_t defaultWorkerMemoryBytes(int workers) {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGESIZE);
+  const size_t total = pages > 0 && pageSize > 0 ? size_t(pages) * size_t(pageSize) : 8ull << 30;
+  // A quarter (at least 1 GiB) for the server, its caches and the system; the rest split.
+  const size_t reserve = std::max<size_t>(total / 4, 1ull << 30);
+  const size_t share = total > reserve ? (total - reserve) / std::max(workers, 1) : 0;
+  return std::max<size_t>(share, 1ull << 30);
+}
 
 WorkerPool::WorkerPool(const PoolOptions& options) : options_(options) {
   int count = options_.workers;
   if (count <= 0) count = std::max(1u, std::thread::hardware_concurrency());
   options_.workers = count;
+  if (options_.isolation == Isolation::Process && options_.limits.maxWorkerMemoryBytes == 0) {
+    options_.limits.maxWorkerMemoryBytes = defaultWorkerMemoryBytes(count);
+  }
+  if (options_.isolation == Isolation::Thread) {
+    sharedReferenceCache_ =
+        std::make_unique<render::oracle::ReferenceSceneCache>(options_.referenceCacheBytes);
+  }
   status_.resize(count);
+  referenceCounters_.resize(count);
 
   // Workers report their GL context before taking jobs, so that the first request after the
   // server says "listening" does not pay for context creation and /healthz is right at once.
-  int started = 0;
-  std::condition_variable startedCv;
   for (int i = 0; i < count; ++i) {
-    workers_.emplace_back([this, i, &started, &startedCv] {
-      std::unique_ptr<render::raster::Rasterizer> rasterizer;
-      try {
-        rasterizer = std::make_unique<render::raster::Rasterizer>();
-        status_[i].ready = true;
-        status_[i].device = rasterizer->device();
-      } catch (const std::exception& e) {
-        status_[i].error = e.what();
+    workers_.emplace_back([this, i] {
+      if (options_.isolation == Isolation::Process) {
+        processWorkerMain(static_cast<size_t>(i));
+      } else {
+        threadWorkerMain(static_cast<size_t>(i));
       }
-      {
-        // Notified under the lock: the constructor's locals must outlive this notification.
-        std::lock_guard lock(mutex_);
-        if (rasterizer) ++readyWorkers_;
-        ++started;
-        startedCv.notify_all();
-      }
-      if (rasterizer) workerLoop(*rasterizer);
       std::lock_guard lock(mutex_);
       ++exitedWorkers_;
       jobSettled_.notify_all();
@@ -83,7 +121,7 @@ WorkerPool::WorkerPool(const PoolOptions& options) : options_(options) {
   }
   {
     std::unique_lock lock(mutex_);
-    startedCv.wait(lock, [&] { return started == count; });
+    jobSettled_.wait(lock, [&] { return started_ == count; });
   }
   watchdog_ = std::thread([this] { watchdogMain(); });
 }
@@ -93,24 +131,193 @@ WorkerPool::~WorkerPool() {
   join();
 }
 
-WorkerPool::Abandon WorkerPool::submit(Work work, Reply reply) {
+void WorkerPool::reportStarted(size_t slot, WorkerStatus status) {
+  std::lock_guard lock(mutex_);
+  if (!status.ready) ++glFailures_;
+  status_[slot] = std::move(status);
+  ++started_;
+  jobSettled_.notify_all();
+}
+
+void WorkerPool::threadWorkerMain(size_t slot) {
+  WorkerStatus status;
+  std::unique_ptr<render::raster::Rasterizer> rasterizer;
+  try {
+    rasterizer = std::make_unique<render::raster::Rasterizer>();
+    status.ready = true;
+    status.device = rasterizer->device();
+  } catch (const std::exception& e) {
+    status.error = e.what();
+  }
+  reportStarted(slot, std::move(status));
+  if (!rasterizer) return;
+
+  render::pipeline::RenderContext context;
+  context.rasterizer = rasterizer.get();
+  context.referenceCache = sharedReferenceCache_.get();
+  while (std::shared_ptr<Job> job = nextJob(slot)) {
+    const auto start = Clock::now();
+    api::Answer answer = runHere(*job, context);
+    finishJob(slot, job, std::move(answer), start);
+  }
+}
+
+std::unique_ptr<WorkerProcess> WorkerPool::startWorkerProcess(size_t slot) {
+  WorkerProcessOptions options;
+  options.executable = options_.workerExecutable;
+  options.config.limits = options_.limits;
+  options.config.referenceCacheBytes =
+      options_.referenceCacheBytes / static_cast<size_t>(options_.workers);
+  options.maxMemoryBytes = options_.limits.maxWorkerMemoryBytes;
+  for (;;) {
+    std::string error;
+    try {
+      auto worker = std::make_unique<WorkerProcess>(options);
+      std::lock_guard lock(mutex_);
+      ++workerStarts_;
+      WorkerStatus& status = status_[slot];
+      status.ready = worker->ready().ok;
+      status.error = worker->ready().error;
+      status.device = worker->ready().device;
+      status.pid = worker->pid();
+      ++status.starts;
+      return worker;
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    std::cerr << "limn: " << error << "\n";
+    std::unique_lock lock(mutex_);
+    status_[slot].ready = false;
+    status_[slot].pid = 0;
+    status_[slot].error = error;
+    if (started_ < options_.workers && status_[slot].starts == 0) return nullptr;
+    if (workAvailable_.wait_for(lock, kRestartBackoff, [this] { return stopping_; })) {
+      return nullptr;
+    }
+  }
+}
+
+void WorkerPool::processWorkerMain(size_t slot) {
+  std::unique_ptr<WorkerProcess> worker = startWorkerProcess(slot);
+  reportStarted(slot, workerStatus()[slot]);
+  if (!worker || !worker->ready().ok) return;
+
+  render::pipeline::RenderContext serverContext;  // for work run here: no GL context
+  for (;;) {
+    std::shared_ptr<Job> job = nextJob(slot, kIdleCheck);
+    // A worker that died between jobs (killed from outside, the OOM killer) is replaced
+    // before it is given one: no request is answered for it.
+    if (std::optional<WorkerProcess::Outcome> gone = worker->exitedWhileIdle()) {
+      std::cerr << "limn: idle render worker " << worker->pid() << " " << gone->crash << "\n";
+      if (!(worker = replaceWorker(slot, std::move(worker), *gone))) {
+        if (job)
+          finishJob(slot, job, unavailableAnswer("no render worker could be started"),
+                    Clock::now());
+        return;
+      }
+    }
+    if (!job) {
+      if (stopping()) return;
+      continue;  // the idle check's wake-up
+    }
+    const auto start = Clock::now();
+    if (job->work) {
+      api::Answer answer = runHere(*job, serverContext);
+      finishJob(slot, job, std::move(answer), start);
+      continue;
+    }
+    wire::Run run{job->requestId, job->task, job->deadline, nullptr};
+    if (options_.meshes) {
+      if (std::optional<std::string> id = referencedMeshId(job->task)) {
+        run.mesh = options_.meshes->find(*id);
+      }
+    }
+    WorkerProcess::Outcome outcome = worker->run(run, job->token);
+    if (outcome.answer) {
+      {
+        std::lock_guard lock(mutex_);
+        referenceCounters_[slot] = outcome.answer->referenceCache;
+      }
+      finishJob(slot, job, std::move(outcome.answer->answer), start);
+      continue;
+    }
+    // The worker died on this job: the job alone is answered for it (never retried: it may be
+    // what killed the worker), and the slot starts a new one before it takes another job.
+    const int pid = worker->pid();
+    std::cerr << "limn: render worker " << pid << " " << outcome.crash << " (request "
+              << job->requestId << ", " << endpointPath(job->task.endpoint) << ")\n";
+    finishJob(slot, job, crashAnswer(outcome, pid, job->requestId), start);
+    if (!(worker = replaceWorker(slot, std::move(worker), outcome))) return;
+  }
+}
+
+std::unique_ptr<WorkerProcess> WorkerPool::replaceWorker(size_t slot,
+                                                         std::unique_ptr<WorkerProcess> dead,
+                                                         const WorkerProcess::Outcome& outcome) {
+  dead.reset();
+  {
+    std::lock_guard lock(mutex_);
+    ++crashes_[outcome.signal.empty() ? "exit" : outcome.signal];
+    status_[slot].ready = false;
+    status_[slot].pid = 0;
+    // The lost cache's lookups stay counted (counters never go back), its entries do not.
+    retiredReferenceLookups_.hits += referenceCounters_[slot].hits;
+    retiredReferenceLookups_.misses += referenceCounters_[slot].misses;
+    retiredReferenceLookups_.evictions += referenceCounters_[slot].evictions;
+    referenceCounters_[slot] = {};
+  }
+  std::unique_ptr<WorkerProcess> worker = startWorkerProcess(slot);
+  if (worker && !worker->ready().ok) {
+    std::lock_guard lock(mutex_);
+    ++glFailures_;
+    return nullptr;
+  }
+  return worker;
+}
+
+bool WorkerPool::stopping() const {
+  std::lock_guard lock(mutex_);
+  return stopping_;
+}
+
+api::Answer WorkerPool::runHere(Job& job, render::pipeline::RenderContext& context) {
+  try {
+    if (job.work) return job.work(context, job.token);
+    return runTask(job.task, options_.limits, context, job.token, options_.meshes);
+  } catch (const std::exception& e) {
+    return api::errorAnswer({500, "internal", std::string("render failed: ") + e.what()});
+  } catch (...) {
+    return api::errorAnswer({500, "internal", "render failed"});
+  }
+}
+
+WorkerPool::Abandon WorkerPool::submit(Task task, Reply reply, uint64_t requestId) {
+  return enqueue(std::make_shared<Job>(std::move(task), nullptr, requestId, std::move(reply),
+                                       Clock::now() + options_.timeout));
+}
+
+WorkerPool::Abandon WorkerPool::submitInServer(Work work, Reply reply) {
+  return enqueue(std::make_shared<Job>(Task{}, std::move(work), 0, std::move(reply),
+                                       Clock::now() + options_.timeout));
+}
+
+WorkerPool::Abandon WorkerPool::enqueue(std::shared_ptr<Job> job) {
   api::Answer refusal;
   {
     std::lock_guard lock(mutex_);
     if (stopping_ || draining_) {
       refusal = unavailableAnswer("the server is shutting down");
-    } else if (readyWorkers_ == 0) {
+    } else if (glFailures_ == options_.workers) {
       refusal = unavailableAnswer("no render worker has an OpenGL context: " +
                                   (status_.empty() ? std::string() : status_.front().error));
     } else if (queue_.size() >= options_.queueDepth) {
       ++rejectedBusy_;
       refusal = busyAnswer(options_.queueDepth, retryAfterSecondsLocked());
     } else {
-      auto job =
-          std::make_shared<Job>(std::move(work), std::move(reply), Clock::now() + options_.timeout);
       job->deadlineEntry = deadlines_.emplace(job->deadline, job);
       queue_.push_back(job);
-      workAvailable_.notify_one();
+      // Every idle slot checks whether it is the lowest-numbered one (nextJob).
+      workAvailable_.notify_all();
       // Only an earlier deadline than the watchdog's next one needs to wake it.
       if (job->deadlineEntry == deadlines_.begin()) deadlinesChanged_.notify_one();
       // The pool outlives the connections (HttpServer stops them first); the handle holds the
@@ -120,7 +327,7 @@ WorkerPool::Abandon WorkerPool::submit(Work work, Reply reply) {
       };
     }
   }
-  reply(std::move(refusal));
+  job->reply(std::move(refusal));
   return {};
 }
 
@@ -154,50 +361,59 @@ WorkerPool::Reply WorkerPool::claimLocked(Job& job) {
   return reply;
 }
 
-void WorkerPool::workerLoop(render::raster::Rasterizer& rasterizer) {
-  render::pipeline::RenderContext context;
-  context.rasterizer = &rasterizer;
-  context.referenceCache = options_.referenceCache;
-  for (;;) {
-    std::shared_ptr<Job> job;
-    {
-      std::unique_lock lock(mutex_);
-      workAvailable_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-      if (stopping_) return;
-      job = std::move(queue_.front());
-      queue_.pop_front();
-      running_.insert(job);
-      ++busyWorkers_;
-    }
+std::shared_ptr<WorkerPool::Job> WorkerPool::nextJob(size_t slot,
+                                                     std::chrono::milliseconds wakeAfter) {
+  std::unique_lock lock(mutex_);
+  idle_.insert(slot);
+  // The k-th lowest idle slot takes a job when at least k jobs wait: the lowest idle slot
+  // always gets the front one.
+  auto mine = [&] {
+    const size_t rank = static_cast<size_t>(std::distance(idle_.begin(), idle_.find(slot)));
+    return rank < queue_.size();
+  };
+  const bool woken =
+      wakeAfter.count() > 0
+          ? workAvailable_.wait_for(lock, wakeAfter, [&] { return stopping_ || mine(); })
+          : (workAvailable_.wait(lock, [&] { return stopping_ || mine(); }), true);
+  idle_.erase(slot);
+  if (stopping_ || !woken) return nullptr;
+  std::shared_ptr<Job> job = std::move(queue_.front());
+  queue_.pop_front();
+  running_.insert(job);
+  ++busyWorkers_;
+  status_[slot].busy = true;
+  status_[slot].endpoint = job->work ? "" : endpointPath(job->task.endpoint);
+  status_[slot].requestId = job->requestId;
+  return job;
+}
 
-    auto start = Clock::now();
-    api::Answer answer;
-    try {
-      answer = job->work(context, job->token);
-    } catch (const std::exception& e) {
-      answer = api::errorAnswer({500, "internal", std::string("render failed: ") + e.what()});
-    } catch (...) {
-      answer = api::errorAnswer({500, "internal", "render failed"});
-    }
-    double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (options_.metrics) {
-      options_.metrics->jobRan(std::chrono::duration<double>(start - job->queued).count(), seconds,
-                               answer);
-    }
-
-    Reply reply;
-    {
-      std::lock_guard lock(mutex_);
-      --busyWorkers_;
-      running_.erase(job);
-      renderSecondsSum_ += seconds;
-      ++renderCount_;
-      reply = claimLocked(*job);
-      jobSettled_.notify_all();
-    }
-    job->work = nullptr;  // frees the request body now rather than when the last owner lets go
-    if (reply) reply(std::move(answer));
-    if (seconds > kTrimAfterSeconds) returnFreedMemory();
+void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::Answer answer,
+                           Clock::time_point started) {
+  const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  if (options_.metrics) {
+    options_.metrics->jobRan(std::chrono::duration<double>(started - job->queued).count(), seconds,
+                             answer);
+  }
+  Reply reply;
+  {
+    std::lock_guard lock(mutex_);
+    --busyWorkers_;
+    status_[slot].busy = false;
+    status_[slot].endpoint = "";
+    status_[slot].requestId = 0;
+    running_.erase(job);
+    renderSecondsSum_ += seconds;
+    ++renderCount_;
+    reply = claimLocked(*job);
+    jobSettled_.notify_all();
+    // A slot that went idle may now be the lowest-numbered one for a waiting job.
+    workAvailable_.notify_all();
+  }
+  job->work = nullptr;  // frees the request body now rather than when the last owner lets go
+  job->task = {};
+  if (reply) reply(std::move(answer));
+  if (options_.isolation == Isolation::Thread && seconds > kTrimAfterSeconds) {
+    returnFreedMemory();
   }
 }
 
@@ -284,17 +500,23 @@ void WorkerPool::join() {
 int WorkerPool::retryAfterSecondsLocked() const {
   // Roughly how long until a queue slot frees: the mean render time times the jobs ahead,
   // spread over the workers; at least one second, at most a minute.
-  if (renderCount_ == 0 || readyWorkers_ == 0) return 1;
+  const int ready = options_.workers - glFailures_;
+  if (renderCount_ == 0 || ready <= 0) return 1;
   double mean = renderSecondsSum_ / static_cast<double>(renderCount_);
-  double wait = mean * static_cast<double>(queue_.size() + busyWorkers_) / readyWorkers_;
+  double wait = mean * static_cast<double>(queue_.size() + busyWorkers_) / ready;
   return static_cast<int>(std::clamp(std::ceil(wait), 1.0, 60.0));
+}
+
+std::vector<WorkerStatus> WorkerPool::workerStatus() const {
+  std::lock_guard lock(mutex_);
+  return status_;
 }
 
 PoolSnapshot WorkerPool::snapshot() const {
   std::lock_guard lock(mutex_);
   PoolSnapshot s;
   s.workers = static_cast<int>(status_.size());
-  s.readyWorkers = readyWorkers_;
+  for (const WorkerStatus& w : status_) s.readyWorkers += w.ready;
   s.busyWorkers = busyWorkers_;
   s.queued = queue_.size();
   s.queueCapacity = options_.queueDepth;
@@ -304,6 +526,21 @@ PoolSnapshot WorkerPool::snapshot() const {
   s.timedOut = timedOut_;
   s.cancelled = cancelled_;
   s.abandoned = abandoned_;
+  s.workerStarts = workerStarts_;
+  s.crashes = crashes_;
+  if (sharedReferenceCache_) {
+    s.referenceCache = sharedReferenceCache_->counters();
+  } else {
+    s.referenceCache = retiredReferenceLookups_;
+    for (const auto& c : referenceCounters_) {
+      s.referenceCache.hits += c.hits;
+      s.referenceCache.misses += c.misses;
+      s.referenceCache.evictions += c.evictions;
+      s.referenceCache.entries += c.entries;
+      s.referenceCache.bytes += c.bytes;
+      s.referenceCache.capacityBytes += c.capacityBytes;
+    }
+  }
   return s;
 }
 

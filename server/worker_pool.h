@@ -1,13 +1,23 @@
-// WorkerPool: the fixed set of render threads behind POST /v1/render.
+// WorkerPool: the fixed set of render workers behind POST /v1/render and the other computing
+// endpoints.
 //
-// Each worker constructs its own raster::Rasterizer (an EGL context is bound to the thread that
-// made it) when it starts, then takes jobs from one bounded queue. The pool owns every rule about
-// a job's life that does not depend on HTTP framing:
+// A worker is a slot with a thread in the server. By default (Isolation::Process) each slot's
+// thread drives a child process of its own (server/worker_process.h: `limn worker`, with its
+// own EGL context and reference cache) and sends it one Task at a time; a crash, a memory
+// ceiling or a hang of that process costs only the request it held, which is answered 500
+// worker_crashed (never retried: it may be the poison), and the slot starts a new process at
+// once. With Isolation::Thread (debugging, unit tests) the slot's thread runs the task itself
+// with its own Rasterizer, as limn did before it had worker processes.
+//
+// The pool owns every rule about a job's life that does not depend on HTTP framing:
 //  - admission: a full queue answers 429 busy (with Retry-After) at once, a stopped pool or one
 //    without a single working GL context answers 503 unavailable;
+//  - dispatch: a job goes to the lowest-numbered idle worker, so that a client's requests in
+//    turn meet the same worker's reference cache;
 //  - deadline: each job gets a CancelToken with deadline now + timeout; a watchdog thread
 //    answers 504 timeout the moment the deadline passes, whether the job is still queued
-//    (it leaves the queue) or running (its token is cancelled and the worker drops its result);
+//    (it leaves the queue) or running (its token is cancelled and the worker drops its result;
+//    a worker process that has not stopped within its grace is killed and replaced);
 //  - shutdown: drain() refuses new jobs (503) and waits, up to a deadline, for the queued and
 //    running ones to finish; stop() answers every job still queued or running 503 and cancels
 //    the running ones; joinFor() waits a bounded time for the threads to end.
@@ -25,35 +35,64 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <unordered_set>
 #include <vector>
 
+#include "api/config.h"
 #include "api/render_api.h"
 #include "render/core/cancel.h"
+#include "render/mesh/mesh_cache.h"
+#include "render/oracle/reference_scene.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
 #include "server/service_metrics.h"
+#include "server/tasks.h"
+#include "server/worker_process.h"
 
 namespace limn::server {
+
+enum class Isolation { Process, Thread };
 
 struct PoolOptions {
   int workers = 0;                            // 0 = one per core
   size_t queueDepth = 64;                     // jobs waiting, not counting running ones
   std::chrono::milliseconds timeout{60'000};  // per job, from submission
-  // Shared by every worker's jobs (owned by the caller, outliving the pool); null: none.
-  render::oracle::ReferenceSceneCache* referenceCache = nullptr;
+  Isolation isolation = Isolation::Thread;
+  // What each task may consume; limits.maxWorkerMemoryBytes is each worker process' ceiling.
+  render::pipeline::JobLimits limits;
+  // Reference scenes kept for later requests with the same mesh and camera: one cache of this
+  // size shared by the threads, or this size split between the worker processes.
+  size_t referenceCacheBytes = 0;
+  // Uploaded meshes that tasks may name by id (owned by the caller, outliving the pool).
+  render::mesh::MeshCache* meshes = nullptr;
+  // Isolation::Process: the limn executable the workers run.
+  std::string workerExecutable = "/proc/self/exe";
   // Where each job's queue wait, run time and stage times are recorded; null: nowhere.
   ServiceMetrics* metrics = nullptr;
 };
 
-// What one worker thread reported when it tried to make its GL context.
+// What one worker reported when it tried to make its GL context, and how it is now.
 struct WorkerStatus {
   bool ready = false;
   std::string error;  // why the Rasterizer could not be made, when !ready
   render::raster::DeviceInfo device;
+  int pid = 0;                // the worker process (0 with Isolation::Thread)
+  bool busy = false;          // running a job now
+  const char* endpoint = "";  // the running job's path ("/v1/render"; "" for server work)
+  uint64_t requestId = 0;     // the running job's request
+  size_t starts = 0;          // processes started for this slot (1 + replacements)
 };
+
+// The pool a limn process runs with `config`: its workers, queue, timeout, isolation, limits
+// and reference cache (the caller sets meshes and metrics).
+PoolOptions poolOptions(const api::ServiceConfig& config);
+
+// The default ceiling of each worker process' memory: the machine's memory, less a share kept
+// for the server and the system, split between `workers`.
+size_t defaultWorkerMemoryBytes(int workers);
 
 // A snapshot of the pool's counters for /healthz, /readyz and /metrics.
 struct PoolSnapshot {
@@ -65,11 +104,17 @@ struct PoolSnapshot {
   bool stopping = false;
   size_t renderCount = 0;  // jobs run to their end
   size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
-  size_t abandoned = 0;  // jobs whose client went away before their answer
+  size_t abandoned = 0;                   // jobs whose client went away before their answer
+  size_t workerStarts = 0;                // worker processes started, first ones included
+  std::map<std::string, size_t> crashes;  // worker processes lost, by signal ("SIGSEGV")
+  render::oracle::ReferenceSceneCache::Counters referenceCache;  // summed over the workers
 };
 
 class WorkerPool {
  public:
+  // Work that needs the server's own state (an upload into its mesh cache, a job into its
+  // table): run on a worker's thread in the server, with that thread's RenderContext under
+  // Isolation::Thread and an empty one (no rasterizer) under Isolation::Process.
   using Work =
       std::function<api::Answer(render::pipeline::RenderContext&, const render::CancelToken&)>;
   using Reply = std::function<void(api::Answer)>;
@@ -85,10 +130,13 @@ class WorkerPool {
   // 499 nobody reads. Safe to call from any thread, any number of times, after the pool's end.
   using Abandon = std::function<void()>;
 
-  // Queues `work`; `reply` gets its answer, or the 429/503/504 the pool gives instead.
-  // `work` must not throw (a throw becomes 500 internal anyway). The returned handle abandons
-  // the job (empty when the job was refused at once).
-  Abandon submit(Work work, Reply reply);
+  // Queues `task`; `reply` gets its answer, or the 429/503/504 the pool gives instead, or 500
+  // worker_crashed naming `requestId` when its worker process dies. The returned handle
+  // abandons the job (empty when the job was refused at once).
+  Abandon submit(Task task, Reply reply, uint64_t requestId = 0);
+  // The same for work run in the server process. `work` must not throw (a throw becomes 500
+  // internal anyway).
+  Abandon submitInServer(Work work, Reply reply);
 
   // Refuses new jobs (503) and waits until every queued and running job has been answered or
   // `deadline` passed; true when none is left.
@@ -103,14 +151,34 @@ class WorkerPool {
 
   // ---- Introspection ----
   PoolSnapshot snapshot() const;
-  const std::vector<WorkerStatus>& workerStatus() const { return status_; }
+  std::vector<WorkerStatus> workerStatus() const;
   const PoolOptions& options() const { return options_; }
 
  private:
   struct Job;
   using Deadlines = std::multimap<render::CancelToken::Clock::time_point, std::shared_ptr<Job>>;
 
-  void workerLoop(render::raster::Rasterizer& rasterizer);
+  Abandon enqueue(std::shared_ptr<Job> job);
+  void threadWorkerMain(size_t slot);
+  void processWorkerMain(size_t slot);
+  // The slot's first worker has made its GL context or failed to: the constructor may return.
+  void reportStarted(size_t slot, WorkerStatus status);
+  // A new worker process for `slot` (retried while the pool runs), or null once it stops.
+  std::unique_ptr<WorkerProcess> startWorkerProcess(size_t slot);
+  // The next job for `slot` (the lowest-numbered idle slot takes the queue's front), or null
+  // when the pool stops or, with `wakeAfter`, when that passes first.
+  std::shared_ptr<Job> nextJob(size_t slot, std::chrono::milliseconds wakeAfter = {});
+  // Counts the dead worker's end and starts its successor (null: none could be started).
+  std::unique_ptr<WorkerProcess> replaceWorker(size_t slot, std::unique_ptr<WorkerProcess> dead,
+                                               const WorkerProcess::Outcome& outcome);
+  bool stopping() const;
+  // How often an idle worker process is checked for having died between jobs.
+  static constexpr std::chrono::milliseconds kIdleCheck{200};
+  // Runs `job` on the slot's thread (work in the server, or a task under Isolation::Thread).
+  api::Answer runHere(Job& job, render::pipeline::RenderContext& context);
+  // Records the job's end and gives it its answer (unless it was answered already).
+  void finishJob(size_t slot, const std::shared_ptr<Job>& job, api::Answer answer,
+                 render::CancelToken::Clock::time_point started);
   void watchdogMain();
   // Marks a job settled under the lock and hands back its reply, or nothing when it was settled
   // already (the watchdog and a worker can race for the same job).
@@ -122,7 +190,8 @@ class WorkerPool {
   static void returnFreedMemory();
 
   PoolOptions options_;
-  std::vector<WorkerStatus> status_;  // written before the constructor returns, then read-only
+  // Isolation::Thread: the one cache every thread shares.
+  std::unique_ptr<render::oracle::ReferenceSceneCache> sharedReferenceCache_;
   std::vector<std::thread> workers_;
   std::thread watchdog_;
 
@@ -132,12 +201,20 @@ class WorkerPool {
   std::condition_variable jobSettled_;  // drain() and joinFor() wait on it
   std::deque<std::shared_ptr<Job>> queue_;
   std::unordered_set<std::shared_ptr<Job>> running_;
+  std::vector<WorkerStatus> status_;  // by slot
+  std::set<size_t> idle_;             // slots waiting for a job
+  // Each worker process' reference cache as it last reported, and the lookups of those lost.
+  std::vector<render::oracle::ReferenceSceneCache::Counters> referenceCounters_;  // by slot
+  render::oracle::ReferenceSceneCache::Counters retiredReferenceLookups_;
+  int started_ = 0;     // slots whose first worker has reported
+  int glFailures_ = 0;  // slots whose worker could not make a GL context
   Deadlines deadlines_;
   bool stopping_ = false;
   bool draining_ = false;
   int exitedWorkers_ = 0;
-  int readyWorkers_ = 0;
   int busyWorkers_ = 0;
+  size_t workerStarts_ = 0;
+  std::map<std::string, size_t> crashes_;
   double renderSecondsSum_ = 0;
   size_t renderCount_ = 0;
   size_t rejectedBusy_ = 0, timedOut_ = 0, cancelled_ = 0, abandoned_ = 0;

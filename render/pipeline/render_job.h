@@ -99,6 +99,10 @@ struct JobLimits {
   // requested outputs): each frame holds its images until the answer is written.
   size_t maxFrames = 120;
   size_t maxFramePixels = size_t{1} << 24;
+  // Resident memory of one render worker process (the server's process isolation; the engine
+  // does not read it): past it the worker is killed and its request answered as a crash.
+  // 0: sized from the machine's memory and the worker count.
+  size_t maxWorkerMemoryBytes = 0;
 };
 
 struct RenderJob {

@@ -12,6 +12,7 @@
 #include "render/core/error.h"
 #include "render/rules/limit.h"
 #include "render/rules/refine.h"
+#include "render/subdiv/far_limit.h"
 #include "render/subdiv/far_point.h"
 #include "render/tessellate/tessellate.h"
 
@@ -65,8 +66,8 @@ Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
   }
   const Far::TopologyLevel& last = refiner->GetLevel(level);
   const int vertexCount = last.GetNumVertices();
-  std::vector<subdiv::FarPoint> limit(vertexCount), du(vertexCount), dv(vertexCount);
-  primvar.Limit(src, limit, du, dv);
+  std::vector<subdiv::FarPoint> limit, du, dv;
+  subdiv::limitOfLastLevel(*refiner, src, limit, du, dv);  // not PrimvarRefiner::Limit: far_limit.h
 
   Refined out;
   for (int v = 0; v < vertexCount; ++v) {

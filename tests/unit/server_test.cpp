@@ -150,7 +150,7 @@ TEST(WorkerPool, RunsJobsOnWorkersThatOwnARasterizer) {
 
   Captured captured;
   std::thread::id caller = std::this_thread::get_id();
-  pool.submit(
+  pool.submitInServer(
       [caller](RenderContext& context, const CancelToken&) {
         EXPECT_NE(context.rasterizer, nullptr);
         EXPECT_NE(std::this_thread::get_id(), caller);
@@ -173,12 +173,12 @@ TEST(WorkerPool, FullQueueAnswers429WithRetryAfterAtOnce) {
     return ok();
   };
   Captured running, queued, refused;
-  pool.submit(blocked, running.reply());
+  pool.submitInServer(blocked, running.reply());
   // Wait until the worker has taken the first job, so the second one is the one waiting.
   for (int i = 0; i < 500 && pool.snapshot().busyWorkers == 0; ++i)
     std::this_thread::sleep_for(2ms);
-  pool.submit(blocked, queued.reply());
-  pool.submit(blocked, refused.reply());
+  pool.submitInServer(blocked, queued.reply());
+  pool.submitInServer(blocked, refused.reply());
 
   api::Answer answer = refused.wait(1s);
   EXPECT_EQ(answer.status, 429);
@@ -197,7 +197,7 @@ TEST(WorkerPool, DeadlineAnswers504WhileTheWorkerIsStillBusyAndCancelsIt) {
   std::atomic<bool> workReturned{false};
   Captured captured;
   auto start = std::chrono::steady_clock::now();
-  pool.submit(
+  pool.submitInServer(
       [&](RenderContext&, const CancelToken& cancel) {
         // A render that would run for 10 s unless it notices its token.
         auto until = std::chrono::steady_clock::now() + 10s;
@@ -226,13 +226,13 @@ TEST(WorkerPool, JobsStillQueuedAtTheirDeadlineAreDroppedWith504) {
   Gate gate;
   std::atomic<bool> secondRan{false};
   Captured first, second;
-  pool.submit(
+  pool.submitInServer(
       [&gate](RenderContext&, const CancelToken&) {
         gate.wait();
         return ok();
       },
       first.reply());
-  pool.submit(
+  pool.submitInServer(
       [&secondRan](RenderContext&, const CancelToken&) {
         secondRan = true;
         return ok();
@@ -250,7 +250,7 @@ TEST(WorkerPool, StopAnswers503ToQueuedAndRunningJobsAndCancelsTheRunningOnes) {
   WorkerPool pool(options(1, 4));
   std::atomic<bool> runningCancelled{false};
   Captured running, queued, late;
-  pool.submit(
+  pool.submitInServer(
       [&](RenderContext&, const CancelToken& cancel) {
         while (!cancel.expired()) std::this_thread::sleep_for(1ms);
         runningCancelled = true;
@@ -259,14 +259,14 @@ TEST(WorkerPool, StopAnswers503ToQueuedAndRunningJobsAndCancelsTheRunningOnes) {
       running.reply());
   for (int i = 0; i < 500 && pool.snapshot().busyWorkers == 0; ++i)
     std::this_thread::sleep_for(2ms);
-  pool.submit([](RenderContext&, const CancelToken&) { return ok(); }, queued.reply());
+  pool.submitInServer([](RenderContext&, const CancelToken&) { return ok(); }, queued.reply());
 
   pool.stop();
   EXPECT_EQ(running.wait(1s).status, 503);
   api::Answer dropped = queued.wait(1s);
   EXPECT_EQ(dropped.status, 503);
   EXPECT_EQ(errorCode(dropped), "unavailable");
-  pool.submit([](RenderContext&, const CancelToken&) { return ok(); }, late.reply());
+  pool.submitInServer([](RenderContext&, const CancelToken&) { return ok(); }, late.reply());
   api::Answer refused = late.wait(1s);
   EXPECT_EQ(refused.status, 503);
   EXPECT_EQ(errorCode(refused), "unavailable");
@@ -277,7 +277,7 @@ TEST(WorkerPool, StopAnswers503ToQueuedAndRunningJobsAndCancelsTheRunningOnes) {
 TEST(WorkerPool, AThrowingJobBecomes500) {
   WorkerPool pool(options(1, 1));
   Captured captured;
-  pool.submit(
+  pool.submitInServer(
       [](RenderContext&, const CancelToken&) -> api::Answer { throw std::runtime_error("boom"); },
       captured.reply());
   api::Answer answer = captured.wait();
@@ -464,13 +464,13 @@ TEST(HttpServer, SlowRequestsGet408AndIdleConnectionsAreClosed) {
 TEST(WorkerPool, DrainLetsRunningJobsFinishThenStopCancelsTheRest) {
   WorkerPool pool(options(1, 4));
   Captured quick, slow, late;
-  pool.submit(sleepJob(200ms), quick.reply());
+  pool.submitInServer(sleepJob(200ms), quick.reply());
   std::this_thread::sleep_for(50ms);  // the quick job is running
-  pool.submit(sleepJob(10s), slow.reply());
+  pool.submitInServer(sleepJob(10s), slow.reply());
   auto start = std::chrono::steady_clock::now();
   std::thread draining([&] { EXPECT_FALSE(pool.drain(start + 600ms)); });
   std::this_thread::sleep_for(50ms);
-  pool.submit(sleepJob(1ms), late.reply());
+  pool.submitInServer(sleepJob(1ms), late.reply());
   EXPECT_EQ(late.wait(1s).status, 503) << "no new jobs while draining";
   EXPECT_EQ(quick.wait(2s).status, 200) << "a job that fits the drain finishes";
   draining.join();
@@ -485,7 +485,7 @@ TEST(WorkerPool, JoinForGivesUpOnAWorkerThatIgnoresItsCancellation) {
   auto pool = std::make_unique<WorkerPool>(options(1, 1));
   std::atomic<bool> release{false};
   Captured stuck;
-  pool->submit(
+  pool->submitInServer(
       [&release](render::pipeline::RenderContext&, const render::CancelToken&) {
         while (!release) std::this_thread::sleep_for(5ms);
         return api::Answer{};

@@ -1,0 +1,49 @@
+#include "server/tasks.h"
+
+#include "api/compare_api.h"
+#include "api/implicit_api.h"
+#include "api/render_api.h"
+#include "api/silhouette_api.h"
+
+namespace limn::server {
+
+api::Answer runTask(const Task& task, const render::pipeline::JobLimits& limits,
+                    render::pipeline::RenderContext& context, const render::CancelToken& cancel,
+                    render::mesh::MeshCache* meshes) {
+  switch (task.endpoint) {
+    case Endpoint::Render:
+      return api::handleRender(task.body, limits, context, cancel, meshes);
+    case Endpoint::Silhouette:
+      return api::handleSilhouette(task.body, task.accept, limits, cancel, meshes);
+    case Endpoint::Tessellate:
+      return api::handleTessellate(task.body, task.accept, limits, cancel, meshes);
+    case Endpoint::Implicit:
+      return api::handleImplicit(task.body, task.accept, limits, context, cancel);
+    case Endpoint::Compare:
+      return api::handleCompare(task.body, limits, context, cancel, meshes);
+  }
+  return api::errorAnswer({500, "internal", "unknown task endpoint"});
+}
+
+std::optional<std::string> referencedMeshId(const Task& task) {
+  if (task.endpoint == Endpoint::Implicit) return std::nullopt;
+  return api::referencedMeshId(task.body);
+}
+
+const char* endpointPath(Endpoint endpoint) {
+  switch (endpoint) {
+    case Endpoint::Render:
+      return "/v1/render";
+    case Endpoint::Silhouette:
+      return "/v1/silhouette";
+    case Endpoint::Tessellate:
+      return "/v1/tessellate";
+    case Endpoint::Implicit:
+      return "/v1/implicit";
+    case Endpoint::Compare:
+      return "/v1/compare";
+  }
+  return "?";
+}
+
+}  // namespace limn::server

@@ -1,0 +1,40 @@
+// Task: one unit of engine work a request asks for — an endpoint's name and the request as it
+// came — and runTask(), which runs it through that endpoint's api handler. The server's worker
+// pool runs tasks on its worker threads or sends them to its worker processes; `limn render`
+// runs one in its own process. A task is plain data so that it can cross a process boundary.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "api/answer.h"
+#include "render/core/cancel.h"
+#include "render/mesh/mesh_cache.h"
+#include "render/pipeline/render_job.h"
+
+namespace limn::server {
+
+enum class Endpoint : uint8_t { Render, Silhouette, Tessellate, Implicit, Compare };
+
+struct Task {
+  Endpoint endpoint = Endpoint::Render;
+  std::string body;
+  std::string accept = {};  // the Accept header: silhouette, tessellate and implicit may answer
+                            // SVG or a mesh file instead of JSON
+};
+
+// The endpoint's handler on the task. Never throws (every failure is its JSON error answer).
+// `meshes` resolves the {"mesh": {"id"}} of render, silhouette, tessellate and compare bodies.
+api::Answer runTask(const Task& task, const render::pipeline::JobLimits& limits,
+                    render::pipeline::RenderContext& context, const render::CancelToken& cancel,
+                    render::mesh::MeshCache* meshes);
+
+// The id of the uploaded mesh a task's body refers to ({"mesh": {"id": "..."}}), if any: the
+// server hands that mesh to the worker process that runs the task.
+std::optional<std::string> referencedMeshId(const Task& task);
+
+const char* endpointPath(Endpoint endpoint);
+
+}  // namespace limn::server
