@@ -59,6 +59,9 @@ ApiError fromInputError(const render::InputError& error) {
       return tooLarge(error.subject(), "", error.what());
     case render::InputError::Kind::InvalidParameter:
       return invalidRequest(error.subject(), error.what());
+    case render::InputError::Kind::EmptySurface:
+      return {422, "empty_surface", error.what(),
+              json::detailObject({{"subject", error.subject()}})};
   }
   return {500, "internal", error.what()};
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <fstream>
 #include <iostream>
 #include <utility>
 
@@ -82,9 +83,23 @@ PoolOptions poolOptions(const api::ServiceConfig& config) {
   return options;
 }
 
-size_t defaultWorkerMemoryBytes(int workers) {
+namespace {
+
+// The memory this process may use: the machine's, or less when a cgroup (v2: a container's
+// memory limit) says so.
+size_t availableMemoryBytes() {
   const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGESIZE);
-  const size_t total = pages > 0 && pageSize > 0 ? size_t(pages) * size_t(pageSize) : 8ull << 30;
+  size_t total = pages > 0 && pageSize > 0 ? size_t(pages) * size_t(pageSize) : 8ull << 30;
+  std::ifstream cgroup("/sys/fs/cgroup/memory.max");
+  size_t limit = 0;
+  if (cgroup >> limit && limit > 0) total = std::min(total, limit);  // "max" reads as nothing
+  return total;
+}
+
+}  // namespace
+
+size_t defaultWorkerMemoryBytes(int workers) {
+  const size_t total = availableMemoryBytes();
   // A quarter (at least 1 GiB) for the server, its caches and the system; the rest split.
   const size_t reserve = std::max<size_t>(total / 4, 1ull << 30);
   const size_t share = total > reserve ? (total - reserve) / std::max(workers, 1) : 0;

@@ -14,6 +14,7 @@ class InputError : public std::runtime_error {
     InvalidMesh,       // the mesh is malformed or the scheme cannot take it (422)
     InvalidParameter,  // a parameter is out of its range (400)
     LimitExceeded,     // a configured resource limit would be exceeded (413)
+    EmptySurface,      // the input is valid but describes no surface at all (422)
   };
 
   // `subject` names the culprit: a limit key ("maxFaces"), a parameter ("params.level"),

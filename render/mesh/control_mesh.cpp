@@ -168,7 +168,8 @@ void validateMesh(const ControlMesh& mesh, const MeshLimits& limits) {
   if (static_cast<int>(mesh.holes.size()) >= mesh.faceCount()) {
     std::unordered_set<int> distinct(mesh.holes.begin(), mesh.holes.end());
     if (static_cast<int>(distinct.size()) == mesh.faceCount()) {
-      invalid("holes", "every face is a hole: nothing to render");
+      throw InputError(InputError::Kind::EmptySurface, "holes",
+                       "every face is a hole: the mesh has no surface to render");
     }
   }
 }

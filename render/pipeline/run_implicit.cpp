@@ -1,4 +1,5 @@
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "render/core/error.h"
@@ -74,11 +75,30 @@ Bounds surfaceBounds(const tessellate::TriangleMesh& mesh, const implicit::Field
 
 }  // namespace
 
+namespace {
+
+// A field whose primitives all stay below the iso value bounds nothing: there is no surface to
+// polygonise, draw or measure (a field that bounds a region is drawn even when the polygoniser
+// finds nothing in it: that miss is what the metrics are for).
+void checkHasSurface(const implicit::Field& field, double iso) {
+  const double diagonal = field.bounds().diagonal();
+  if (!(diagonal > 0) || !std::isfinite(diagonal)) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", iso);
+    throw InputError(InputError::Kind::EmptySurface, "field.iso",
+                     std::string("the field has no surface at iso ") + value +
+                         ": no primitive reaches that value anywhere");
+  }
+}
+
+}  // namespace
+
 ImplicitMesh polygonizeImplicit(const ImplicitJob& job, const JobLimits& limits,
                                 const CancelToken& cancel) {
   Stopwatch clock;
   checkImplicitJob(job, limits);
   const implicit::Field field(job.field);
+  checkHasSurface(field, job.field.iso);
   ImplicitMesh out;
   out.timings.surfaceMs = clock.lapMs();
   implicit::Polygonization p =
@@ -97,6 +117,7 @@ RenderResult runImplicit(const ImplicitJob& job, const JobLimits& limits, Render
   Stopwatch clock, total;
   checkImplicitJob(job, limits);
   const implicit::Field field(job.field);
+  checkHasSurface(field, job.field.iso);
   const double surfaceMs = clock.lapMs();
   cancel.check();
 

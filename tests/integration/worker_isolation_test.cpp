@@ -255,6 +255,37 @@ TEST(WorkerIsolation, ARequestPastTheMemoryCeilingCostsOnlyItself) {
   EXPECT_EQ(post(port, "/v1/render", meshBody(kCubeObj, "adaptive", 256)).status, 200);
 }
 
+// Nothing to draw is an answer: a surface that does not exist is a 422 naming why, a camera
+// that sees nothing is a 200 with empty pictures — never a 500, for any method.
+TEST(EmptySurfaces, AreAnswersNotInternalErrors) {
+  ServerProcess server;
+  const int port = server.port();
+  HttpResponse noField = post(port, "/v1/implicit", R"({"field": {"iso": 1e308, "primitives":
+      [{"type": "blobby", "center": [0, 0, 0], "radius": 1}]}, "reference": true,
+      "camera": {"width": 64, "height": 64}})");
+  EXPECT_EQ(noField.status, 422) << noField.body;
+  EXPECT_EQ(errorCode(noField), "empty_surface");
+  EXPECT_NE(noField.body.find("field.iso"), std::string::npos);
+
+  std::string allHoles = kCubeObj;
+  for (int f = 0; f < 6; ++f) allHoles += "t hole 1/0/0 " + std::to_string(f) + "\\n";
+  auto lookingAway = [](const char* method) {
+    return R"({"mesh": {"format": "obj", "data": ")" + std::string(kCubeObj) +
+           R"("}, "method": ")" + method + R"(", "reference": true, "camera": {"width": 64,
+           "height": 64, "eye": [0, 0, 5], "target": [0, 0, 10]}})";
+  };
+  for (const char* method : {"coarse", "uniform", "adaptive", "silhouette", "patches", "limit"}) {
+    HttpResponse holes = post(port, "/v1/render", meshBody(allHoles, method, 64));
+    EXPECT_EQ(holes.status, 422) << method << ": " << holes.body;
+    EXPECT_EQ(errorCode(holes), "empty_surface") << method;
+    HttpResponse nothing = post(port, "/v1/render", lookingAway(method));
+    ASSERT_EQ(nothing.status, 200) << method << ": " << nothing.body.substr(0, 300);
+    auto answer = parseJson(nothing.body);
+    if (std::string(method) == "limit") continue;  // the reference itself: nothing to measure
+    EXPECT_EQ(answer["metrics"]["silhouette"]["iou"].GetDouble(), 1.0) << method;
+  }
+}
+
 TEST(WorkerIsolation, ThreadWorkersRemainAnOptionForDebugging) {
   auto server = ServerProcess::withConfig(R"({"workers": 1, "workerIsolation": "thread"})");
   auto h = health(server.port());
