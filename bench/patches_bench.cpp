@@ -304,7 +304,7 @@ int main(int argc, char** argv) {
   for (auto& s : testing::corpusShapes()) shapes.push_back(std::move(s));
   shapes = testing::selectShapes(std::move(shapes), options.shapes);
   raster::Rasterizer rasterizer;
-  pipeline::RenderContext context{&rasterizer, nullptr};
+  pipeline::RenderContext context{.rasterizer = &rasterizer};
   std::printf("# The patches method\n\nRenderer: %s; %u hardware threads.\n\n",
               rasterizer.device().renderer.c_str(), std::thread::hardware_concurrency());
   printPatchCounts(shapes);

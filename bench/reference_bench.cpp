@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   }
   render::raster::Rasterizer rasterizer;
   render::oracle::ReferenceSceneCache cache(size_t{1} << 30);
-  render::pipeline::RenderContext context{&rasterizer, &cache};
+  render::pipeline::RenderContext context{.rasterizer = &rasterizer, .referenceCache = &cache};
   std::printf("renderer: %s; %u hardware threads; %d x %d, S = %d; best of %d warm runs%s\n\n",
               rasterizer.device().renderer.c_str(), std::thread::hardware_concurrency(),
               config.size, config.size, config.supersample, config.repeat,

@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
     }
   }
   render::raster::Rasterizer rasterizer;
-  render::pipeline::RenderContext context{&rasterizer};
+  render::pipeline::RenderContext context{.rasterizer = &rasterizer};
   std::printf("renderer: %s; %u hardware threads; warm times, best of %d\n\n",
               rasterizer.device().renderer.c_str(), std::thread::hardware_concurrency(),
               config.repeat);

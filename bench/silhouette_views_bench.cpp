@@ -256,7 +256,7 @@ void printWorst(std::vector<ViewResult> all, int count, const std::string& dump)
 int main(int argc, char** argv) {
   const Options options = parse(argc, argv);
   raster::Rasterizer rasterizer;
-  pipeline::RenderContext context{&rasterizer, nullptr};
+  pipeline::RenderContext context{.rasterizer = &rasterizer};
   std::vector<testing::NamedMesh> shapes = testing::ownShapes();
   for (auto& s : testing::corpusShapes()) shapes.push_back(std::move(s));
   shapes = testing::selectShapes(std::move(shapes), options.shapes);

@@ -1045,7 +1045,7 @@ TEST(HandleRender, RendersTheCubeEndToEnd) {
   } catch (const std::exception& e) {
     GTEST_SKIP() << "no EGL/OpenGL context: " << e.what();
   }
-  render::pipeline::RenderContext context{rasterizer.get()};
+  render::pipeline::RenderContext context{.rasterizer = rasterizer.get()};
   render::CancelToken cancel;
   api::Answer answer =
       api::handleRender(cubeRequest(R"(, "method": "uniform", "params": {"level": 2},

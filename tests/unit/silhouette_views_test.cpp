@@ -67,7 +67,7 @@ TEST_P(SilhouetteViews, OutlineWithinAPixelFromRandomViews) {
   job.methods.push_back({pipeline::Method::Silhouette, {}, Shading::Smooth});
   job.outputs = {.color = true};
   raster::Rasterizer rasterizer;
-  pipeline::RenderContext context{&rasterizer, nullptr};
+  pipeline::RenderContext context{.rasterizer = &rasterizer};
   pipeline::CompareResult result = pipeline::compare(job, {}, context, CancelToken());
 
   const bool closed = testing::isClosedClass(testing::shapeClass(shape.mesh));
