@@ -86,6 +86,13 @@ WorkerPool::Abandon answerNow(Router::Reply& reply, api::Answer answer) {
   return {};
 }
 
+// The answer of the /v1/jobs routes on a server made without a job manager (tests).
+api::Answer noJobs(const Request& request) {
+  const std::string path(pathOf(request.target));
+  return api::errorAnswer(
+      {404, "not_found", "this server runs no jobs", api::json::detailObject({{"path", path}})});
+}
+
 std::string jobId(const Request& request) {
   return std::string(pathOf(request.target).substr(kJobPrefix.size()));
 }
@@ -195,7 +202,7 @@ WorkerPool::Abandon Router::uploadMesh(const Route&, Request& request, Reply& re
 // cancellation are answered at once. The rows themselves go through the pool as comparisons
 // (server/jobs.h).
 WorkerPool::Abandon Router::createJob(const Route&, Request& request, Reply& reply) {
-  if (!jobs_) return getJob(kRoutes[0], request, reply);  // the same 404
+  if (!jobs_) return answerNow(reply, noJobs(request));
   return pool_.submitInServer([jobs = jobs_, body = std::move(request.body)](
                                   render::pipeline::RenderContext&,
                                   const render::CancelToken&) { return jobs->create(body); },
@@ -203,17 +210,12 @@ WorkerPool::Abandon Router::createJob(const Route&, Request& request, Reply& rep
 }
 
 WorkerPool::Abandon Router::getJob(const Route&, Request& request, Reply& reply) {
-  if (!jobs_) {
-    const std::string path(pathOf(request.target));
-    return answerNow(reply, api::errorAnswer({404, "not_found", "this server runs no jobs",
-                                              api::json::detailObject({{"path", path}})}));
-  }
-  if (request.method == "POST") return {};  // unreachable: createJob handles it
+  if (!jobs_) return answerNow(reply, noJobs(request));
   return answerNow(reply, jobs_->get(jobId(request), offsetParameter(request.target)));
 }
 
-WorkerPool::Abandon Router::cancelJob(const Route& route, Request& request, Reply& reply) {
-  if (!jobs_) return getJob(route, request, reply);
+WorkerPool::Abandon Router::cancelJob(const Route&, Request& request, Reply& reply) {
+  if (!jobs_) return answerNow(reply, noJobs(request));
   return answerNow(reply, jobs_->cancel(jobId(request)));
 }
 

@@ -241,9 +241,13 @@ void WorkerPool::processWorkerMain(size_t slot) {
       finishJob(slot, job, std::move(answer), start);
       continue;
     }
-    wire::Run run{job->requestId, job->task, job->deadline, nullptr};
+    // The body moves into the message (the job keeps its endpoint for the log).
+    wire::Run run{job->requestId,
+                  {job->task.endpoint, std::move(job->task.body), std::move(job->task.accept)},
+                  job->deadline,
+                  nullptr};
     if (options_.meshes) {
-      if (std::optional<std::string> id = referencedMeshId(job->task)) {
+      if (std::optional<std::string> id = referencedMeshId(run.task)) {
         run.mesh = options_.meshes->find(*id);
       }
     }
