@@ -264,6 +264,8 @@ WorkerPool::Abandon Router::healthz(const Route&, Request&, Reply& reply) {
   integer("queueCapacity", static_cast<int64_t>(pool.queueCapacity));
   integer("workerStarts", static_cast<int64_t>(pool.workerStarts));
   integer("workerCrashes", static_cast<int64_t>(crashes));
+  out.Key("spareWorkerReady");
+  out.Bool(pool.spareReady);
   out.Key("uptimeS");
   out.Double(uptime);
   out.Key("workerStates");

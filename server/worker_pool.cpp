@@ -139,6 +139,9 @@ WorkerPool::WorkerPool(const PoolOptions& options) : options_(options) {
     jobSettled_.wait(lock, [&] { return started_ == count; });
   }
   watchdog_ = std::thread([this] { watchdogMain(); });
+  if (options_.isolation == Isolation::Process && glFailures_ < count) {
+    spareThread_ = std::thread([this] { spareMain(); });
+  }
 }
 
 WorkerPool::~WorkerPool() {
@@ -177,25 +180,34 @@ void WorkerPool::threadWorkerMain(size_t slot) {
   }
 }
 
-std::unique_ptr<WorkerProcess> WorkerPool::startWorkerProcess(size_t slot) {
+WorkerProcessOptions WorkerPool::workerProcessOptions() const {
   WorkerProcessOptions options;
   options.executable = options_.workerExecutable;
   options.config.limits = options_.limits;
   options.config.referenceCacheBytes =
       options_.referenceCacheBytes / static_cast<size_t>(options_.workers);
   options.maxMemoryBytes = options_.limits.maxWorkerMemoryBytes;
+  options.abandonStart = &stopRequested_;
+  return options;
+}
+
+void WorkerPool::adoptLocked(size_t slot, const WorkerProcess& worker) {
+  WorkerStatus& status = status_[slot];
+  status.ready = worker.ready().ok;
+  status.error = worker.ready().error;
+  status.device = worker.ready().device;
+  status.pid = worker.pid();
+  ++status.starts;
+}
+
+std::unique_ptr<WorkerProcess> WorkerPool::startWorkerProcess(size_t slot) {
   for (;;) {
     std::string error;
     try {
-      auto worker = std::make_unique<WorkerProcess>(options);
+      auto worker = std::make_unique<WorkerProcess>(workerProcessOptions());
       std::lock_guard lock(mutex_);
       ++workerStarts_;
-      WorkerStatus& status = status_[slot];
-      status.ready = worker->ready().ok;
-      status.error = worker->ready().error;
-      status.device = worker->ready().device;
-      status.pid = worker->pid();
-      ++status.starts;
+      adoptLocked(slot, *worker);
       return worker;
     } catch (const std::exception& e) {
       error = e.what();
@@ -210,6 +222,44 @@ std::unique_ptr<WorkerProcess> WorkerPool::startWorkerProcess(size_t slot) {
       return nullptr;
     }
   }
+}
+
+void WorkerPool::spareMain() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    spareWanted_.wait(lock, [this] { return stopping_ || !spare_; });
+    if (stopping_) break;
+    lock.unlock();
+    std::unique_ptr<WorkerProcess> worker;
+    try {
+      worker = std::make_unique<WorkerProcess>(workerProcessOptions());
+    } catch (const std::exception& e) {
+      if (!stopRequested_) std::cerr << "limn: spare render worker: " << e.what() << "\n";
+    }
+    lock.lock();
+    if (worker && worker->ready().ok) {
+      ++workerStarts_;
+      spare_ = std::move(worker);
+    } else if (spareWanted_.wait_for(lock, kRestartBackoff, [this] { return stopping_; })) {
+      break;
+    }
+  }
+  std::unique_ptr<WorkerProcess> last = std::move(spare_);
+  lock.unlock();  // its destructor waits for the process
+}
+
+std::unique_ptr<WorkerProcess> WorkerPool::takeSpare(size_t slot) {
+  std::unique_ptr<WorkerProcess> spare;
+  {
+    std::lock_guard lock(mutex_);
+    spare = std::move(spare_);
+    spareWanted_.notify_one();
+  }
+  // A spare that died waiting (the OOM killer, anyone's kill) is no use.
+  if (!spare || spare->exitedWhileIdle()) return nullptr;
+  std::lock_guard lock(mutex_);
+  adoptLocked(slot, *spare);
+  return spare;
 }
 
 void WorkerPool::processWorkerMain(size_t slot) {
@@ -285,7 +335,10 @@ std::unique_ptr<WorkerProcess> WorkerPool::replaceWorker(size_t slot,
     retiredReferenceLookups_.evictions += referenceCounters_[slot].evictions;
     referenceCounters_[slot] = {};
   }
-  std::unique_ptr<WorkerProcess> worker = startWorkerProcess(slot);
+  if (stopping()) return nullptr;  // shutting down: nothing more to run
+  // The spare is ready at once; a new process takes its GL context's time (seconds under load).
+  std::unique_ptr<WorkerProcess> worker = takeSpare(slot);
+  if (!worker) worker = startWorkerProcess(slot);
   if (worker && !worker->ready().ok) {
     std::lock_guard lock(mutex_);
     ++glFailures_;
@@ -482,6 +535,7 @@ void WorkerPool::stop() {
     std::lock_guard lock(mutex_);
     if (stopping_) return;
     stopping_ = true;
+    stopRequested_ = true;
     for (auto& job : queue_) {
       if (Reply reply = claimLocked(*job)) replies.push_back(std::move(reply));
     }
@@ -494,6 +548,7 @@ void WorkerPool::stop() {
   }
   workAvailable_.notify_all();
   deadlinesChanged_.notify_all();
+  spareWanted_.notify_all();
   for (auto& reply : replies) reply(unavailableAnswer("the server is shutting down"));
 }
 
@@ -514,6 +569,7 @@ void WorkerPool::join() {
     if (worker.joinable()) worker.join();
   }
   if (watchdog_.joinable()) watchdog_.join();
+  if (spareThread_.joinable()) spareThread_.join();
 }
 
 int WorkerPool::retryAfterSecondsLocked() const {
@@ -546,6 +602,7 @@ PoolSnapshot WorkerPool::snapshot() const {
   s.cancelled = cancelled_;
   s.abandoned = abandoned_;
   s.workerStarts = workerStarts_;
+  s.spareReady = spare_ != nullptr;
   s.crashes = crashes_;
   if (sharedReferenceCache_) {
     s.referenceCache = sharedReferenceCache_->counters();

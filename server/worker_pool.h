@@ -27,6 +27,7 @@
 // (a worker, the watchdog, or the submitter for an immediate refusal).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
@@ -104,8 +105,9 @@ struct PoolSnapshot {
   bool stopping = false;
   size_t renderCount = 0;  // jobs run to their end
   size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
-  size_t abandoned = 0;                   // jobs whose client went away before their answer
-  size_t workerStarts = 0;                // worker processes started, first ones included
+  size_t abandoned = 0;     // jobs whose client went away before their answer
+  size_t workerStarts = 0;  // worker processes started, first ones included
+  bool spareReady = false;  // Isolation::Process: a started worker waits to replace a lost one
   std::map<std::string, size_t> crashes;  // worker processes lost, by signal ("SIGSEGV")
   render::oracle::ReferenceSceneCache::Counters referenceCache;  // summed over the workers
 };
@@ -165,6 +167,14 @@ class WorkerPool {
   void reportStarted(size_t slot, WorkerStatus status);
   // A new worker process for `slot` (retried while the pool runs), or null once it stops.
   std::unique_ptr<WorkerProcess> startWorkerProcess(size_t slot);
+  WorkerProcessOptions workerProcessOptions() const;
+  // Shows `worker` as the slot's in /healthz.
+  void adoptLocked(size_t slot, const WorkerProcess& worker);
+  // Keeps one started, idle worker process in reserve, so that a crashed worker is replaced at
+  // once rather than after a GL context's start (a second or more on a loaded machine).
+  void spareMain();
+  // The spare for `slot`, or null when there is none (or it died waiting).
+  std::unique_ptr<WorkerProcess> takeSpare(size_t slot);
   // The next job for `slot` (the lowest-numbered idle slot takes the queue's front), or null
   // when the pool stops or, with `wakeAfter`, when that passes first.
   std::shared_ptr<Job> nextJob(size_t slot, std::chrono::milliseconds wakeAfter = {});
@@ -194,6 +204,10 @@ class WorkerPool {
   std::unique_ptr<render::oracle::ReferenceSceneCache> sharedReferenceCache_;
   std::vector<std::thread> workers_;
   std::thread watchdog_;
+  std::thread spareThread_;
+  std::unique_ptr<WorkerProcess> spare_;  // Isolation::Process: the next replacement
+  std::condition_variable spareWanted_;
+  std::atomic<bool> stopRequested_{false};  // stopping_, for worker starts to give up on
 
   mutable std::mutex mutex_;
   std::condition_variable workAvailable_;

@@ -82,8 +82,7 @@ WorkerProcess::WorkerProcess(const WorkerProcessOptions& options) : options_(opt
     throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   }
   std::optional<std::string> frame;
-  if (wire::writeFrame(socket_, wire::encode(options_.config)) &&
-      waitReadable(socket_, options_.startTimeout)) {
+  if (wire::writeFrame(socket_, wire::encode(options_.config)) && waitForReady()) {
     frame = wire::readFrame(socket_);
   }
   if (!frame) {
@@ -94,15 +93,30 @@ WorkerProcess::WorkerProcess(const WorkerProcessOptions& options) : options_(opt
   ready_ = wire::decodeReady(*frame);
 }
 
-WorkerProcess::~WorkerProcess() {
-  ::close(socket_);  // the worker exits when it sees the end of its socket
-  if (exited_) return;
-  for (int i = 0; i < 50; ++i) {
-    if (::waitpid(pid_, nullptr, WNOHANG) == pid_) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+bool WorkerProcess::waitForReady() const {
+  const auto giveUp = Clock::now() + options_.startTimeout;
+  while (Clock::now() < giveUp) {
+    if (waitReadable(socket_, std::chrono::milliseconds(50))) return true;
+    if (options_.abandonStart && options_.abandonStart->load()) return false;
   }
+  return false;
+}
+
+// A killed process can take seconds to be torn down on a loaded machine (its threads must each
+// be scheduled to exit): a thread of its own waits for it, so that neither a replacement nor
+// the server's shutdown waits too.
+static void reapInBackground(pid_t pid) {
+  std::thread([pid] {
+    while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+    }
+  }).detach();
+}
+
+WorkerProcess::~WorkerProcess() {
+  ::close(socket_);
+  if (exited_) return;
   ::kill(pid_, SIGKILL);
-  ::waitpid(pid_, nullptr, 0);
+  reapInBackground(pid_);
 }
 
 std::optional<WorkerProcess::Outcome> WorkerProcess::exitedWhileIdle() {
@@ -118,11 +132,15 @@ size_t WorkerProcess::residentBytes() const {
 }
 
 WorkerProcess::Outcome WorkerProcess::reap(std::string why, bool kill) {
-  if (kill) ::kill(pid_, SIGKILL);
+  exited_ = true;
+  if (kill) {
+    ::kill(pid_, SIGKILL);
+    reapInBackground(pid_);
+    return {std::nullopt, std::move(why), "SIGKILL"};
+  }
   int status = 0;
   while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
   }
-  exited_ = true;
   Outcome out;
   if (WIFSIGNALED(status)) {
     out.signal = signalName(WTERMSIG(status));

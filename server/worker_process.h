@@ -9,6 +9,7 @@
 
 #include <sys/types.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -29,6 +30,8 @@ struct WorkerProcessOptions {
   // killed: every stage checks its cancel token well within this.
   std::chrono::milliseconds cancelGrace{2'000};
   std::chrono::milliseconds startTimeout{30'000};  // to make the GL context and say Ready
+  // When set and true, a start still waiting for its Ready gives up (the pool is stopping).
+  const std::atomic<bool>* abandonStart = nullptr;
 };
 
 class WorkerProcess {
@@ -37,7 +40,7 @@ class WorkerProcess {
   // started or does not answer within startTimeout; a worker without a GL context is started
   // (ready().ok false) so that /healthz can say why.
   explicit WorkerProcess(const WorkerProcessOptions& options);
-  ~WorkerProcess();  // closes the socket, then kills and reaps the process if it lingers
+  ~WorkerProcess();  // kills and reaps the process (it holds nothing that needs a clean exit)
   WorkerProcess(const WorkerProcess&) = delete;
   WorkerProcess& operator=(const WorkerProcess&) = delete;
 
@@ -63,6 +66,8 @@ class WorkerProcess {
   size_t residentBytes() const;
 
  private:
+  // Until the worker's Ready can be read; false after startTimeout or when abandoned.
+  bool waitForReady() const;
   // Kills the process (when `why` is set), reaps it and says how it ended.
   Outcome reap(std::string why, bool kill);
 

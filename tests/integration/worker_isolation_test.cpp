@@ -101,7 +101,7 @@ TEST(WorkerIsolation, UniformRefinementOfAnEdgeSharedByAHundredQuadsRenders) {
   }
   auto h = health(server.port());
   EXPECT_EQ(h["workerCrashes"].GetInt(), 0);
-  EXPECT_EQ(h["workerStarts"].GetInt(), h["workers"].GetInt());
+  for (const auto& w : h["workerStates"].GetArray()) EXPECT_EQ(w["starts"].GetInt(), 1);
 }
 
 // An implicit scene heavy enough to be caught running; rendered again until it is.
@@ -128,6 +128,13 @@ TEST_P(KilledWorker, CostsOnlyItsRequestAndIsReplaced) {
   const std::string signalName = signal == SIGKILL ? "SIGKILL" : "SIGSEGV";
   auto server = ServerProcess::withConfig(R"({"workers": 2, "queueDepth": 64})");
   const int port = server.port();
+
+  // The server keeps a spare worker started to replace a lost one at once; a moment after
+  // start (a GL context's time) it is there.
+  for (int i = 0; i < 3000 && !health(port)["spareWorkerReady"].GetBool(); ++i) {
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(health(port)["spareWorkerReady"].GetBool());
 
   HttpResponse created = post(port, "/v1/jobs", jobSpec());
   ASSERT_EQ(created.status, 202) << created.body.substr(0, 300);
@@ -169,8 +176,12 @@ TEST_P(KilledWorker, CostsOnlyItsRequestAndIsReplaced) {
   ASSERT_NE(killedPid, 0) << "no implicit render was seen running";
   ASSERT_EQ(::kill(killedPid, signal), 0);
   const auto killedAt = Clock::now();
-  while (!victimDone) std::this_thread::sleep_for(1ms);  // the crash has been seen: answered
-  const auto readyAfter = (Clock::now() - killedAt) + waitAllReady(port, 10s);
+  // The server learns of the death when the kernel has torn the process down (its socket
+  // closes): milliseconds on a quiet machine, seconds on a loaded one. From then on the
+  // replacement is the server's own work.
+  while (!victimDone) std::this_thread::sleep_for(1ms);
+  const auto teardown = Clock::now() - killedAt;
+  const auto readyAfter = waitAllReady(port, 10s);
   victimThread.join();
   bystanderThread.join();
 
@@ -183,6 +194,7 @@ TEST_P(KilledWorker, CostsOnlyItsRequestAndIsReplaced) {
   EXPECT_EQ(error["error"]["detail"]["pid"].GetInt(), killedPid);
 
   EXPECT_LT(readyAfter, 2s) << "the worker is replaced at once";
+  EXPECT_LT(teardown, 10s);
   ASSERT_FALSE(bystanders.empty());
   for (int status : bystanders) EXPECT_EQ(status, 200);
 
@@ -200,8 +212,15 @@ TEST_P(KilledWorker, CostsOnlyItsRequestAndIsReplaced) {
   EXPECT_EQ(state, "done");
 
   EXPECT_EQ(metric(port, "limn_worker_crashes_total{signal=\"" + signalName + "\"}"), 1);
-  EXPECT_EQ(metric(port, "limn_worker_starts_total"), 3);
+  // Two workers, one replacement (plus the spare the server keeps started for the next one).
+  EXPECT_GE(metric(port, "limn_worker_starts_total"), 3);
   auto h = health(port);
+  int replacedSlots = 0;
+  for (const auto& w : h["workerStates"].GetArray()) {
+    replacedSlots += w["starts"].GetInt() == 2;
+    EXPECT_NE(w["pid"].GetInt(), killedPid);
+  }
+  EXPECT_EQ(replacedSlots, 1);
   EXPECT_EQ(h["workerCrashes"].GetInt(), 1);
   EXPECT_STREQ(h["status"].GetString(), "ok");
   EXPECT_EQ(server.terminate(SIGTERM), 0);
