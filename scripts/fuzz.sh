@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Runs every libFuzzer target of fuzz/ (built by scripts/sanitize.sh into build-sanitize/) for a
 # bounded time each, two at a time, starting from the seed corpora in fuzz/corpus/ and the
-# dictionaries fuzz/obj.dict and fuzz/json.dict. New inputs are kept in
-# build-sanitize/fuzz-corpus/<target> (so later runs continue from them); a crash, leak,
-# sanitizer report or timeout leaves its input in build-sanitize/fuzz-findings/ and fails the
-# script. Prints one line per target: executions, coverage, corpus size.
+# dictionaries fuzz/obj.dict and fuzz/json.dict (engine, the generated-mesh target, takes none).
+# New inputs are kept in build-sanitize/fuzz-corpus/<target> (so later runs continue from
+# them); a crash, leak, sanitizer report or timeout leaves its input in
+# build-sanitize/fuzz-findings/ and fails the script. Prints one line per target: executions,
+# coverage, corpus size.
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 60 s, every target)
 #   LIMN_FUZZ_RUNS=10000000 scripts/fuzz.sh 0 obj_reader  (a fixed number of executions)
@@ -14,23 +15,35 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift $(( $# > 0 ? 1 : 0 ))
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(obj_reader json_mesh render_request silhouette_request implicit_request config)
-[ -x build-sanitize/bin/obj_reader_fuzz ] || scripts/sanitize.sh -N >/dev/null
+[ ${#targets[@]} -eq 0 ] && targets=(obj_reader json_mesh render_request silhouette_request implicit_request config engine)
+for target in "${targets[@]}"; do
+  [ -x "build-sanitize/bin/${target}_fuzz" ] || { scripts/sanitize.sh -N >/dev/null; break; }
+done
 mkdir -p build-sanitize/fuzz-findings build-sanitize/fuzz-logs
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 
 run_target() {
-  local target=$1 dict=fuzz/json.dict
-  [ "$target" = obj_reader ] && dict=fuzz/obj.dict
+  local target=$1
   local corpus="build-sanitize/fuzz-corpus/$target"
   mkdir -p "$corpus"
   local limit=(-max_total_time="$seconds")
   [ -n "${LIMN_FUZZ_RUNS:-}" ] && limit=(-runs="$LIMN_FUZZ_RUNS")
   # 64 KiB inputs reach every field; 2 GiB and 10 s per input bound what one input may cost.
-  "build-sanitize/bin/${target}_fuzz" "${limit[@]}" -max_len="${LIMN_FUZZ_MAX_LEN:-65536}" \
-    -rss_limit_mb=2048 \
-    -timeout=10 -dict="$dict" -print_final_stats=1 \
+  local options=(-max_len="${LIMN_FUZZ_MAX_LEN:-65536}" -rss_limit_mb=2048 -timeout=10)
+  case "$target" in
+    obj_reader) options+=(-dict=fuzz/obj.dict) ;;
+    # engine: the input is the mesh generator's choices, not text (no dictionary); 4 KiB of
+    # them make meshes of up to 200 faces. Each input renders every method (Mesa's llvmpipe
+    # loaded, so no leak detection: see scripts/sanitize.sh) within a 20 s deadline of its own
+    # (fuzz/engine_fuzz.cpp), hence more time and memory; past 120 s a stage ignored it.
+    engine) options=(-max_len="${LIMN_FUZZ_MAX_LEN:-4096}" -rss_limit_mb=4096 -timeout=120) ;;
+    *) options+=(-dict=fuzz/json.dict) ;;
+  esac
+  local asan="$ASAN_OPTIONS"
+  [ "$target" = engine ] && asan="detect_leaks=0:abort_on_error=1"
+  ASAN_OPTIONS="$asan" "build-sanitize/bin/${target}_fuzz" "${limit[@]}" "${options[@]}" \
+    -print_final_stats=1 \
     -artifact_prefix="build-sanitize/fuzz-findings/${target}-" \
     "$corpus" "fuzz/corpus/$target" >"build-sanitize/fuzz-logs/$target.log" 2>&1
 }

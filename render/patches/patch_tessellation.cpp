@@ -479,16 +479,16 @@ class Tessellator {
 
   // The edge from corner k to the next, cut where finer neighbours' corners lie on it.
   void splitEdge(const PatchDomain& domain, int from, int to, Vec2 a, Vec2 b, int depth,
-                 std::vector<Piece>& out) {
-    if (depth < kMaxSplitDepth) {
+                 int maxDepth, std::vector<Piece>& out) {
+    if (depth < maxDepth) {
       const Vec2 mid = lerp(a, b, 0.5);
       Vec3 position, ds, dt;
       const Vec2 st = domain.toPatch(mid);
       set_.evaluate(set_.patches()[domain.patch], st.x, st.y, position, ds, dt);
       const int m = welder_.find(position);
       if (m >= 0 && m != from && m != to) {
-        splitEdge(domain, from, m, a, mid, depth + 1, out);
-        splitEdge(domain, m, to, mid, b, depth + 1, out);
+        splitEdge(domain, from, m, a, mid, depth + 1, maxDepth, out);
+        splitEdge(domain, m, to, mid, b, depth + 1, maxDepth, out);
         return;
       }
     }
@@ -526,8 +526,20 @@ class Tessellator {
       const PatchDomain& domain = domains_[p];
       const int n = domain.corners();
       for (int k = 0; k < n; ++k) {
-        splitEdge(domain, corners_[p][k], corners_[p][(k + 1) % n], corner(domain, k),
-                  corner(domain, (k + 1) % n), 0, pieces_[p][k]);
+        // At most maxEdgeFactor pieces per side, so that the side's segments can add up to at
+        // most maxEdgeFactor (the plan's promise, and the GPU's hard limit: past
+        // GL_MAX_TESS_GEN_LEVEL the GPU tessellator refuses the plan, a 500). Neighbours that
+        // differ by Far's one level and up to kMaxDomainSplits cuts make at most 2^6 = 64
+        // pieces; more are found only on degenerate surfaces, where patches shrink to points
+        // (coincident control points) and the welder matches nearly every midpoint to some
+        // corner: such a side is cut less deep until it fits (found by fuzz/engine: a pentagon
+        // and a quad sharing three coincident vertices gave a side of 88 pieces).
+        for (int depth = kMaxSplitDepth; depth >= 0; --depth) {
+          pieces_[p][k].clear();
+          splitEdge(domain, corners_[p][k], corners_[p][(k + 1) % n], corner(domain, k),
+                    corner(domain, (k + 1) % n), 0, depth, pieces_[p][k]);
+          if (static_cast<int>(pieces_[p][k].size()) <= options_.maxEdgeFactor) break;
+        }
         if (pieces_[p][k].size() > 1) ++stats_.transitionEdges;
       }
     }
