@@ -80,7 +80,8 @@ void check(const Answer& answer, const RequestVariant& v, const GeneratedMesh& m
   // requestTimeoutMs); before it, a 504 is a finding like any other 5xx.
   if (s == 504 && deadline.expired()) return;
   if (s == 200) {
-    if (!mesh.refusal.empty()) finding("200 for a mesh made invalid (" + mesh.refusal + ")", v, mesh, answer);
+    if (!mesh.refusal.empty())
+      finding("200 for a mesh made invalid (" + mesh.refusal + ")", v, mesh, answer);
     if (v.path == "/v1/compare" && compareRowFailed(answer.body, deadline)) {
       finding("a /v1/compare row failed with a 5xx (or no rows)", v, mesh, answer);
     }
@@ -145,11 +146,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       answer = api::handleCompare(v.body, limits, context(), cancel);
     }
     if (verbose) {
-      std::fprintf(stderr, "  %-40s %d %8.1f ms\n", (v.path + " " + v.label).c_str(),
-                   answer.status,
-                   std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                             start)
-                       .count());
+      std::fprintf(
+          stderr, "  %-40s %d %8.1f ms\n", (v.path + " " + v.label).c_str(), answer.status,
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
     }
     check(answer, v, mesh, cancel);
   }

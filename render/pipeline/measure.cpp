@@ -38,8 +38,8 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
   // has no diagonal to measure depth against: its relative depth differences are 0, as
   // measureGeometry reports its relative distances. (Found by fuzz/engine: "reference": true on
   // such a mesh answered 500, compareDepth refusing the zero diagonal.)
-  m.depth = diagonal == 0 ? metrics::DepthMetrics{}
-                          : metrics::compareDepth(images, refImages, diagonal);
+  m.depth =
+      diagonal == 0 ? metrics::DepthMetrics{} : metrics::compareDepth(images, refImages, diagonal);
   m.normal = metrics::compareNormals(images, refImages);
   if (diff) {
     metrics::DiffImage heat = metrics::colorDifference(images, refImages);

@@ -1,9 +1,9 @@
 // Hostile generated meshes (tests/support/mesh_generator.h) through the real `limn serve`
 // (issue 23): 250 seeded meshes — non-manifold edges and vertices, valences 2-128 (see
-// sweepOptions), n-gons, holes, every boundary rule, creases and corners of every sharpness, degenerate and
-// coincident faces, Catmull-Clark, Loop and bilinear — each sent once per method (coarse;
-// uniform by opensubdiv, masks and factored at a level 0-3; adaptive; silhouette; patches diced
-// by the CPU and the GPU; limit; some with the reference) at 32 x 32, and some to
+// sweepOptions), n-gons, holes, every boundary rule, creases and corners of every sharpness,
+// degenerate and coincident faces, Catmull-Clark, Loop and bilinear — each sent once per method
+// (coarse; uniform by opensubdiv, masks and factored at a level 0-3; adaptive; silhouette; patches
+// diced by the CPU and the GPU; limit; some with the reference) at 32 x 32, and some to
 // /v1/tessellate, /v1/silhouette and /v1/compare. Every answer must be 200, or a 4xx JSON error
 // naming its code and message (a mesh made invalid on purpose must be a 4xx); a 500 (a worker
 // that crashed answers 500 worker_crashed) fails the test with the mesh's seed and request.
@@ -89,8 +89,8 @@ std::string judge(const HttpResponse& r, const RequestVariant& v, const Generate
     }
     return "";
   }
-  const bool clientError = r.status == 400 || r.status == 404 || r.status == 406 ||
-                           r.status == 413 || r.status == 422;
+  const bool clientError =
+      r.status == 400 || r.status == 404 || r.status == 406 || r.status == 413 || r.status == 422;
   if (!clientError) return "answered " + std::to_string(r.status);
   auto doc = parseJson(r.body);
   if (doc.HasParseError() || !doc.IsObject() || !doc.HasMember("error") ||
@@ -195,7 +195,8 @@ TEST(GeneratedMeshFindings, AnsweredWithoutA500) {
     HttpResponse r = post(server.port(), path, body);
     EXPECT_EQ(r.status, 200) << what << ": " << r.body.substr(0, 400);
     if (path == "/v1/compare") {
-      EXPECT_EQ(r.body.find("\"error\""), std::string::npos) << what << ": " << r.body.substr(0, 600);
+      EXPECT_EQ(r.body.find("\"error\""), std::string::npos)
+          << what << ": " << r.body.substr(0, 600);
     }
   }
 }
@@ -209,9 +210,12 @@ TEST(GeneratedMeshSweep, EveryMethodAnswers200Or4xxAndNoWorkerCrashes) {
       SeededChoices choices(variantSeed(seed));
       int k = 0;
       for (const RequestVariant& v : requestVariants(mesh, choices)) {
-        const std::string base = std::string(dir) + "/" + std::to_string(seed) + "-" + std::to_string(k++);
+        const std::string base =
+            std::string(dir) + "/" + std::to_string(seed) + "-" + std::to_string(k++);
         std::ofstream(base + ".json") << v.body;
-        std::ofstream(base + ".txt") << v.path << "\n" << v.accept << "\n" << v.label << "\n"
+        std::ofstream(base + ".txt") << v.path << "\n"
+                                     << v.accept << "\n"
+                                     << v.label << "\n"
                                      << mesh.description << "\n";
       }
     }
@@ -265,9 +269,10 @@ TEST(GeneratedMeshSweep, EveryMethodAnswers200Or4xxAndNoWorkerCrashes) {
         }
         if (problem.empty()) continue;
         failures.push_back(mesh.description + "\n  " + v.path + " " + v.label + ": " + problem +
-                           "\n  answer: " + r.body.substr(0, 600) + "\n  reproduce: " +
-                           "LIMN_SWEEP_SEEDS=" + std::to_string(seeds[i]) + "\n  request: " +
-                           v.body.substr(0, 400) + (v.body.size() > 400 ? "..." : ""));
+                           "\n  answer: " + r.body.substr(0, 600) +
+                           "\n  reproduce: " + "LIMN_SWEEP_SEEDS=" + std::to_string(seeds[i]) +
+                           "\n  request: " + v.body.substr(0, 400) +
+                           (v.body.size() > 400 ? "..." : ""));
       }
     }
   };

@@ -191,9 +191,9 @@ void sheet(Builder& b, ChoiceSource& c, std::string& d) {
   std::vector<int> v((nx + 1) * (ny + 1));
   for (int j = 0; j <= ny; ++j) {
     for (int i = 0; i <= nx; ++i) {
-      v[j * (nx + 1) + i] = b.vertex({static_cast<double>(i) / nx - 0.5,
-                                      static_cast<double>(j) / ny - 0.5,
-                                      amplitude * c.uniform(-1, 1)});
+      v[j * (nx + 1) + i] =
+          b.vertex({static_cast<double>(i) / nx - 0.5, static_cast<double>(j) / ny - 0.5,
+                    amplitude * c.uniform(-1, 1)});
     }
   }
   for (int j = 0; j < ny; ++j) {
@@ -277,7 +277,8 @@ void torus(Builder& b, ChoiceSource& c, std::string& d) {
 void fan(Builder& b, ChoiceSource& c, std::string& d) {
   const int maxValence = b.options().maxValence;
   int k = c.percent(25) ? c.range(65, std::max(65, maxValence)) : c.range(2, 64);
-  const int kind = c.range(0, 5);  // 0 open disc, 1 closed disc, 2 cone, 3 capped, 4 double, 5 quads
+  const int kind =
+      c.range(0, 5);  // 0 open disc, 1 closed disc, 2 cone, 3 capped, 4 double, 5 quads
   const int budget = b.facesLeft() / ((kind == 4 ? 2 : 1) * (kind == 5 ? b.cost(4) : 1));
   k = std::max(2, std::min({k, budget - (kind == 3 ? b.cost(k) : 0), maxValence}));
   if (kind == 3) k = std::max(3, std::min(k, b.options().maxFaceSize));
@@ -458,10 +459,10 @@ void soup(Builder& b, ChoiceSource& c, std::string& d) {
   const int poolSize = c.range(4, 24);
   std::vector<int> pool;
   for (int i = 0; i < poolSize; ++i) {
-    pool.push_back(c.percent(10) && i > 0
-                       ? b.vertexAt(b.points()[pool[c.range(0, i - 1)]])  // coincident
-                       : b.vertex({c.uniform(-0.5, 0.5), c.uniform(-0.5, 0.5),
-                                   c.uniform(-0.5, 0.5)}));
+    pool.push_back(
+        c.percent(10) && i > 0
+            ? b.vertexAt(b.points()[pool[c.range(0, i - 1)]])  // coincident
+            : b.vertex({c.uniform(-0.5, 0.5), c.uniform(-0.5, 0.5), c.uniform(-0.5, 0.5)}));
   }
   const int faces = std::min(c.range(1, 40), b.facesLeft());
   for (int i = 0; i < faces; ++i) {
@@ -495,7 +496,8 @@ void mobius(Builder& b, ChoiceSource& c, std::string& d) {
 void sphere(Builder& b, ChoiceSource& c, std::string& d) {
   int segments = c.range(3, 24), rings = c.range(2, 8);
   auto cost = [&] { return 2 * segments + (rings - 2) * segments * b.cost(4); };
-  while ((segments > 3 || rings > 2) && cost() > b.facesLeft()) (segments > rings ? segments : rings)--;
+  while ((segments > 3 || rings > 2) && cost() > b.facesLeft())
+    (segments > rings ? segments : rings)--;
   const int north = b.vertex({0, 0, 0.5}), south = b.vertex({0, 0, -0.5});
   std::vector<std::vector<int>> v(rings - 1);
   for (int r = 1; r < rings; ++r) {
@@ -522,15 +524,16 @@ void lone(Builder& b, ChoiceSource& c, std::string& d) {
   if (c.percent(50)) {
     const int n = b.scheme() == Scheme::Loop ? 3 : c.range(3, 4);
     std::vector<int> f;
-    for (int i = 0; i < n; ++i) f.push_back(b.vertex({std::cos(2 * M_PI * i / n), std::sin(2 * M_PI * i / n), 0}));
+    for (int i = 0; i < n; ++i)
+      f.push_back(b.vertex({std::cos(2 * M_PI * i / n), std::sin(2 * M_PI * i / n), 0}));
     b.face(f);
   }
   d += " isolated(" + str(isolated) + ")";
 }
 
 using Piece = void (*)(Builder&, ChoiceSource&, std::string&);
-const std::vector<Piece> kPieces = {sheet, box,    torus, fan,    book, bowtie,
-                                    ngon,  degenerate, soup, mobius, sphere, lone};
+const std::vector<Piece> kPieces = {sheet, box,        torus, fan,    book,   bowtie,
+                                    ngon,  degenerate, soup,  mobius, sphere, lone};
 
 // ---------------------------------------------------------------------------------------------
 // Joining pieces after they are made.
@@ -583,9 +586,9 @@ void joins(Builder& b, ChoiceSource& c, std::string& d) {
 // Tags.
 
 float sharpness(ChoiceSource& c) {
-  static const std::vector<float> values = {0.0f, 0.01f, 0.25f, 0.5f,  1.0f,  1.5f,  2.0f,
-                                            3.7f, 5.0f,  9.5f,  9.99f, 10.0f, 10.5f, 20.0f,
-                                            1e3f, 1e6f,  1e30f};
+  static const std::vector<float> values = {0.0f,  0.01f, 0.25f, 0.5f, 1.0f,  1.5f,
+                                            2.0f,  3.7f,  5.0f,  9.5f, 9.99f, 10.0f,
+                                            10.5f, 20.0f, 1e3f,  1e6f, 1e30f};
   if (c.percent(30)) return static_cast<float>(c.uniform(0, 12));
   return c.pick(values);
 }
@@ -649,7 +652,8 @@ void tags(ControlMesh& mesh, ChoiceSource& c, std::string& d) {
     }
     d += " holes(" + str(static_cast<long>(mesh.holes.size())) + ")";
   }
-  const BoundaryInterpolation rules[] = {BoundaryInterpolation::None, BoundaryInterpolation::EdgeOnly,
+  const BoundaryInterpolation rules[] = {BoundaryInterpolation::None,
+                                         BoundaryInterpolation::EdgeOnly,
                                          BoundaryInterpolation::EdgeAndCorner};
   mesh.boundary = rules[c.range(0, 2)];
   mesh.creaseMethod = c.percent(30) ? CreaseMethod::Chaikin : CreaseMethod::Uniform;
@@ -707,7 +711,8 @@ std::string breakMesh(ControlMesh& mesh, ChoiceSource& c, const GeneratorOptions
     }
     case 6:
       if (mesh.scheme == Scheme::Loop) {
-        addFace({addPoint({0, 0, 5}), addPoint({1, 0, 5}), addPoint({1, 1, 5}), addPoint({0, 1, 5})});
+        addFace(
+            {addPoint({0, 0, 5}), addPoint({1, 0, 5}), addPoint({1, 1, 5}), addPoint({0, 1, 5})});
         return "a quad for the loop scheme";
       }
       [[fallthrough]];
@@ -785,15 +790,14 @@ std::string writeObj(const ControlMesh& mesh, ChoiceSource& c, bool absoluteOnly
     for (size_t k = i; k < i + n; ++k) {
       ints += " " + str(mesh.creases[k].v0) + " " + str(mesh.creases[k].v1);
     }
-    auto [floats, values] =
-        sharpnesses(i, n, [&](size_t k) { return mesh.creases[k].sharpness; });
-    tagText += "t crease " + str(static_cast<long>(2 * n)) + "/" + floats + "/0" + ints + values + eol;
+    auto [floats, values] = sharpnesses(i, n, [&](size_t k) { return mesh.creases[k].sharpness; });
+    tagText +=
+        "t crease " + str(static_cast<long>(2 * n)) + "/" + floats + "/0" + ints + values + eol;
   });
   inRuns(mesh.corners.size(), c, [&](size_t i, size_t n) {
     std::string ints;
     for (size_t k = i; k < i + n; ++k) ints += " " + str(mesh.corners[k].vertex);
-    auto [floats, values] =
-        sharpnesses(i, n, [&](size_t k) { return mesh.corners[k].sharpness; });
+    auto [floats, values] = sharpnesses(i, n, [&](size_t k) { return mesh.corners[k].sharpness; });
     tagText += "t corner " + str(static_cast<long>(n)) + "/" + floats + "/0" + ints + values + eol;
   });
   inRuns(mesh.holes.size(), c, [&](size_t i, size_t n) {
@@ -816,7 +820,8 @@ std::string writeObj(const ControlMesh& mesh, ChoiceSource& c, bool absoluteOnly
   if (mesh.triangleSubdivision == TriangleSubdivision::Smooth) {
     tagText += "t smoothtriangles 0/0/1 smooth" + eol;
   } else if (c.percent(30)) {
-    tagText += std::string("t smoothtriangles 0/0/1 ") + (c.percent(50) ? "catmark" : "catmull-clark") + eol;
+    tagText += std::string("t smoothtriangles 0/0/1 ") +
+               (c.percent(50) ? "catmark" : "catmull-clark") + eol;
   }
   if (c.percent(10)) tagText += "t faceedit 0/0/0" + eol;  // unsupported: a warning
 
@@ -964,8 +969,8 @@ std::string cameraJson(ChoiceSource& c, const VariantOptions& options) {
       return R"({"eye": [0, 0, 0], "target": [0.3, 1, 0.2], "fovYDeg": )" + number(fov) + ", " +
              size + "}";
     }
-    return R"({"orbit": {"azimuthDeg": 30, "elevationDeg": 20}, "fovYDeg": )" + number(fov) +
-           ", " + size + "}";
+    return R"({"orbit": {"azimuthDeg": 30, "elevationDeg": 20}, "fovYDeg": )" + number(fov) + ", " +
+           size + "}";
   }
   if (kind == 4) {
     return R"({"orbit": {"azimuthDeg": 0, "elevationDeg": 90}, "up": [0, 0, 1], )" + size + "}";
@@ -1023,8 +1028,11 @@ std::string paramsJson(ChoiceSource& c, const std::string& method, const std::st
       if (c.percent(20)) p.push_back(R"("cullPatches": false)");
     }
   } else if (method == "silhouette") {
-    if (c.percent(40)) p.push_back(std::string(R"("contour": ")") + (c.percent(50) ? "pn" : "exact") + "\"");
-    if (c.percent(30)) p.push_back(R"("presubdivide": )" + (c.percent(30) ? std::string("\"auto\"") : str(c.range(0, 1))));
+    if (c.percent(40))
+      p.push_back(std::string(R"("contour": ")") + (c.percent(50) ? "pn" : "exact") + "\"");
+    if (c.percent(30))
+      p.push_back(R"("presubdivide": )" +
+                  (c.percent(30) ? std::string("\"auto\"") : str(c.range(0, 1))));
     if (c.percent(20)) p.push_back(R"("searchSteps": )" + str(c.range(0, 10)));
     if (c.percent(20)) p.push_back(R"("curveSamples": )" + str(c.range(0, 48)));
   }
@@ -1051,8 +1059,8 @@ std::vector<RequestVariant> requestVariants(const GeneratedMesh& generated, Choi
   for (int v : generated.mesh.faceVertexIndices) {
     if (v >= 0 && v < static_cast<int>(valence.size())) ++valence[v];
   }
-  const bool patches =
-      valence.empty() || *std::max_element(valence.begin(), valence.end()) <= options.maxPatchesValence;
+  const bool patches = valence.empty() || *std::max_element(valence.begin(), valence.end()) <=
+                                              options.maxPatchesValence;
   std::vector<RequestVariant> out;
   for (const Entry& e : entries) {
     const bool reference = c.percent(options.referencePercent);
@@ -1064,9 +1072,8 @@ std::vector<RequestVariant> requestVariants(const GeneratedMesh& generated, Choi
     const std::string params = paramsJson(c, e.method, e.engine, level, e.tessellator);
     const std::string outputs = outputsJson(c, e.method, reference);
     const std::string shading = shadingJson(c, e.method);
-    std::string body = R"({"mesh": )" + mesh + R"(, "method": ")" + e.method +
-                       R"(", "camera": )" + camera + R"(, "params": )" + params +
-                       R"(, "outputs": )" + outputs + shading;
+    std::string body = R"({"mesh": )" + mesh + R"(, "method": ")" + e.method + R"(", "camera": )" +
+                       camera + R"(, "params": )" + params + R"(, "outputs": )" + outputs + shading;
     if (e.method == "adaptive" || e.method == "patches" ||
         (options.displacedReference && e.method == "limit")) {
       const std::string displacement = displacementJson(c);
@@ -1097,7 +1104,8 @@ std::vector<RequestVariant> requestVariants(const GeneratedMesh& generated, Choi
     const bool svg = c.percent(50);
     const std::string camera = cameraJson(c, options);
     const std::string params = paramsJson(c, "silhouette", "", level, "");
-    out.push_back({"/v1/silhouette", "", std::string("silhouette endpoint ") + (svg ? "svg" : "json"),
+    out.push_back({"/v1/silhouette", "",
+                   std::string("silhouette endpoint ") + (svg ? "svg" : "json"),
                    R"({"mesh": )" + mesh + R"(, "camera": )" + camera + R"(, "params": )" + params +
                        R"(, "format": ")" + (svg ? "svg" : "json") + "\"}"});
   }
