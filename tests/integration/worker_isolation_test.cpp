@@ -67,6 +67,14 @@ double metric(int port, const std::string& series) {
   return std::stod(text.substr(at + series.size() + 2));
 }
 
+// Until the server's spare worker (the next replacement) has started: a GL context's time.
+bool spareReady(int port) {
+  for (int i = 0; i < 3000 && !health(port)["spareWorkerReady"].GetBool(); ++i) {
+    std::this_thread::sleep_for(10ms);
+  }
+  return health(port)["spareWorkerReady"].GetBool();
+}
+
 // Until every worker is ready again; how long that took (or `limit` when it did not happen).
 Clock::duration waitAllReady(int port, Clock::duration limit) {
   const auto start = Clock::now();
@@ -129,12 +137,8 @@ TEST_P(KilledWorker, CostsOnlyItsRequestAndIsReplaced) {
   auto server = ServerProcess::withConfig(R"({"workers": 2, "queueDepth": 64})");
   const int port = server.port();
 
-  // The server keeps a spare worker started to replace a lost one at once; a moment after
-  // start (a GL context's time) it is there.
-  for (int i = 0; i < 3000 && !health(port)["spareWorkerReady"].GetBool(); ++i) {
-    std::this_thread::sleep_for(10ms);
-  }
-  ASSERT_TRUE(health(port)["spareWorkerReady"].GetBool());
+  // The server keeps a spare worker started to replace a lost one at once.
+  ASSERT_TRUE(spareReady(port));
 
   HttpResponse created = post(port, "/v1/jobs", jobSpec());
   ASSERT_EQ(created.status, 202) << created.body.substr(0, 300);
@@ -252,6 +256,7 @@ TEST(WorkerIsolation, ARequestPastTheMemoryCeilingCostsOnlyItself) {
   auto server = ServerProcess::withConfig(R"({"workers": 2, "limits": {"maxWorkerMemoryBytes": )" +
                                           std::to_string(ceiling) + "}}");
   const int port = server.port();
+  ASSERT_TRUE(spareReady(port));
 
   std::atomic<bool> bigDone{false};
   HttpResponse big;
