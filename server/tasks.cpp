@@ -1,5 +1,7 @@
 #include "server/tasks.h"
 
+#include <malloc.h>
+
 #include "api/compare_api.h"
 #include "api/implicit_api.h"
 #include "api/render_api.h"
@@ -44,6 +46,11 @@ const char* endpointPath(Endpoint endpoint) {
       return "/v1/compare";
   }
   return "?";
+}
+
+void returnFreedMemoryAfter(double seconds) {
+  constexpr double kTrimAfterSeconds = 0.2;
+  if (seconds > kTrimAfterSeconds) ::malloc_trim(0);
 }
 
 }  // namespace limn::server

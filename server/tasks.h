@@ -37,4 +37,10 @@ std::optional<std::string> referencedMeshId(const Task& task);
 
 const char* endpointPath(Endpoint endpoint);
 
+// After a task that ran `seconds`, hands the memory it freed back to the system when the task
+// was long: a reference at 1024^2 leaves about a gigabyte freed but resident in glibc's arenas
+// (which a worker process' memory ceiling would count); after a small task it is not worth the
+// few milliseconds.
+void returnFreedMemoryAfter(double seconds);
+
 }  // namespace limn::server

@@ -1,6 +1,5 @@
 #include "server/worker_pool.h"
 
-#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -418,12 +417,6 @@ void WorkerPool::abandon(const std::shared_ptr<Job>& job) {
   reply(api::errorAnswer({499, "client_closed", "the client closed the connection"}));
 }
 
-// A large job (a reference at 1024^2 allocates about a gigabyte in passes, masks and
-// tessellations, across the TBB threads' malloc arenas) leaves that memory freed but resident:
-// glibc keeps it for reuse. Handing it back costs a few milliseconds, which is nothing after a
-// job that long and too much after every small one.
-void WorkerPool::returnFreedMemory() { malloc_trim(0); }
-
 WorkerPool::Reply WorkerPool::claimLocked(Job& job) {
   if (job.settled) return {};
   job.settled = true;
@@ -484,9 +477,8 @@ void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::An
   job->work = nullptr;  // frees the request body now rather than when the last owner lets go
   job->task = {};
   if (reply) reply(std::move(answer));
-  if (options_.isolation == Isolation::Thread && seconds > kTrimAfterSeconds) {
-    returnFreedMemory();
-  }
+  // A worker process trims its own memory.
+  if (options_.isolation == Isolation::Thread) returnFreedMemoryAfter(seconds);
 }
 
 void WorkerPool::watchdogMain() {

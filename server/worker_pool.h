@@ -195,9 +195,6 @@ class WorkerPool {
   Reply claimLocked(Job& job);
   void abandon(const std::shared_ptr<Job>& job);
   int retryAfterSecondsLocked() const;
-  // Jobs that ran longer than this return the memory they freed to the system afterwards.
-  static constexpr double kTrimAfterSeconds = 0.2;
-  static void returnFreedMemory();
 
   PoolOptions options_;
   // Isolation::Thread: the one cache every thread shares.

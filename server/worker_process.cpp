@@ -1,7 +1,6 @@
 #include "server/worker_process.h"
 
 #include <fcntl.h>
-#include <malloc.h>
 #include <poll.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
@@ -223,11 +222,6 @@ class CurrentTask {
   std::shared_ptr<render::CancelToken> token_;
 };
 
-// Jobs that ran longer than this return the memory they freed to the system afterwards: a
-// reference at 1024^2 leaves about a gigabyte freed but resident in glibc's arenas, which
-// would count against the worker's memory ceiling; after a small job it is not worth the time.
-constexpr double kTrimAfterSeconds = 0.2;
-
 }  // namespace
 
 int workerMain(int fd) {
@@ -282,9 +276,7 @@ int workerMain(int fd) {
     current.finished();
     message.referenceCache = referenceCache.counters();
     if (!wire::writeAnswer(fd, message)) return 0;
-    if (std::chrono::duration<double>(Clock::now() - start).count() > kTrimAfterSeconds) {
-      ::malloc_trim(0);
-    }
+    returnFreedMemoryAfter(std::chrono::duration<double>(Clock::now() - start).count());
   }
 }
 
