@@ -275,8 +275,8 @@ void WorkerPool::processWorkerMain(size_t slot) {
       std::cerr << "limn: idle render worker " << worker->pid() << " " << gone->crash << "\n";
       if (!(worker = replaceWorker(slot, std::move(worker), *gone))) {
         if (job)
-          finishJob(slot, job, unavailableAnswer("no render worker could be started"),
-                    Clock::now());
+          finishJob(slot, job, unavailableAnswer("no render worker could be started"), Clock::now(),
+                    AfterJob::Restarts);
         return;
       }
     }
@@ -314,7 +314,7 @@ void WorkerPool::processWorkerMain(size_t slot) {
     const int pid = worker->pid();
     std::cerr << "limn: render worker " << pid << " " << outcome.crash << " (request "
               << job->requestId << ", " << endpointPath(job->task.endpoint) << ")\n";
-    finishJob(slot, job, crashAnswer(outcome, pid, job->requestId), start);
+    finishJob(slot, job, crashAnswer(outcome, pid, job->requestId), start, AfterJob::Restarts);
     if (!(worker = replaceWorker(slot, std::move(worker), outcome))) return;
   }
 }
@@ -453,7 +453,7 @@ std::shared_ptr<WorkerPool::Job> WorkerPool::nextJob(size_t slot,
 }
 
 void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::Answer answer,
-                           Clock::time_point started) {
+                           Clock::time_point started, AfterJob after) {
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
   if (options_.metrics) {
     options_.metrics->jobRan(std::chrono::duration<double>(started - job->queued).count(), seconds,
@@ -470,6 +470,7 @@ void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::An
     renderSecondsSum_ += seconds;
     ++renderCount_;
     reply = claimLocked(*job);
+    if (after == AfterJob::TakesNext) idle_.insert(slot);
     jobSettled_.notify_all();
     // A slot that went idle may now be the lowest-numbered one for a waiting job.
     workAvailable_.notify_all();

@@ -186,9 +186,14 @@ class WorkerPool {
   static constexpr std::chrono::milliseconds kIdleCheck{200};
   // Runs `job` on the slot's thread (work in the server, or a task under Isolation::Thread).
   api::Answer runHere(Job& job, render::pipeline::RenderContext& context);
-  // Records the job's end and gives it its answer (unless it was answered already).
+  // What a slot does once its job is answered.
+  enum class AfterJob { TakesNext, Restarts };
+  // Records the job's end and gives it its answer (unless it was answered already). A slot that
+  // takes the next job counts as idle before the answer leaves, so that a client's next request
+  // finds the worker (and the reference cache) that answered its last one.
   void finishJob(size_t slot, const std::shared_ptr<Job>& job, api::Answer answer,
-                 render::CancelToken::Clock::time_point started);
+                 render::CancelToken::Clock::time_point started,
+                 AfterJob after = AfterJob::TakesNext);
   void watchdogMain();
   // Marks a job settled under the lock and hands back its reply, or nothing when it was settled
   // already (the watchdog and a worker can race for the same job).
@@ -213,7 +218,7 @@ class WorkerPool {
   std::deque<std::shared_ptr<Job>> queue_;
   std::unordered_set<std::shared_ptr<Job>> running_;
   std::vector<WorkerStatus> status_;  // by slot
-  std::set<size_t> idle_;             // slots waiting for a job
+  std::set<size_t> idle_;             // slots waiting for a job, or about to (finishJob)
   // Each worker process' reference cache as it last reported, and the lookups of those lost.
   std::vector<render::oracle::ReferenceSceneCache::Counters> referenceCounters_;  // by slot
   render::oracle::ReferenceSceneCache::Counters retiredReferenceLookups_;
