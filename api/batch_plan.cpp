@@ -55,7 +55,10 @@ BatchMesh meshFromJson(const std::string& name, const std::string& meshJson,
   try {
     render::mesh::ControlMesh mesh = request::parseMesh(document, limits, warnings, meshes);
     render::mesh::validateMesh(mesh, limits.mesh);
-    return described(mesh, name, "", meshJson);
+    // A mesh named by id lives in this process's cache only: the plan carries it inline, so
+    // that a job's spec reads the same in every replica and after a restart.
+    const bool byId = document.IsObject() && document.HasMember("id");
+    return described(mesh, name, "", byId ? writeJsonMesh(mesh) : meshJson);
   } catch (const render::InputError& e) {
     throw fromInputError(e);
   }

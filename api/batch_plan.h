@@ -37,7 +37,8 @@ struct BatchMesh {
 // checked against `limits` as /v1/render would. Throws ApiError (422 naming the line...).
 BatchMesh meshFromObj(const std::string& name, const std::string& path, const std::string& text,
                       const std::string& scheme, const render::pipeline::JobLimits& limits);
-// A mesh given inline in a spec (either /v1/render form, or {"id"} of a mesh in `meshes`).
+// A mesh given inline in a spec (either /v1/render form, or {"id"} of a mesh in `meshes`, which
+// the result carries inline: meshJson never refers to a cache).
 BatchMesh meshFromJson(const std::string& name, const std::string& meshJson,
                        const render::pipeline::JobLimits& limits,
                        render::mesh::MeshCache* meshes = nullptr);

@@ -164,6 +164,8 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
     throw ConfigError(source + ": \"logLevel\" must be debug, info, warn, error or off");
   }
   r.integer("jobRetentionSeconds", config.jobRetentionSeconds, 0);
+  r.string("jobStore", config.jobStore);
+  r.integer("jobLeaseSeconds", config.jobLeaseSeconds, 1, 86400);
   r.string("workerIsolation", config.workerIsolation);
   if (config.workerIsolation != "process" && config.workerIsolation != "thread") {
     throw ConfigError(source + ": \"workerIsolation\" must be process or thread");

@@ -45,6 +45,11 @@ struct ServiceConfig {
   size_t maxJobs = 8;
   size_t maxJobRows = 20000;
   int jobRetentionSeconds = 3600;
+  // Where jobs are kept: "sqlite:PATH" or a postgresql:// URI; "" = a SQLite file in the data
+  // folder (LIMN_JOB_STORE and limn serve --job-store override it). A claimed row group's lease
+  // lasts jobLeaseSeconds, renewed every third of it while its replica lives.
+  std::string jobStore;
+  int jobLeaseSeconds = 30;
 };
 
 // A configuration file that cannot be used; the message names the file and the key.

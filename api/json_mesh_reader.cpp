@@ -171,4 +171,65 @@ ControlMesh readJsonMesh(const json::Value& object, const std::string& field,
   return mesh;
 }
 
+std::string writeJsonMesh(const ControlMesh& mesh) {
+  rapidjson::StringBuffer buffer;
+  json::Writer w(buffer);
+  auto ints = [&](const char* key, auto count, auto value) {
+    w.Key(key);
+    w.StartArray();
+    for (size_t i = 0; i < static_cast<size_t>(count); ++i) w.Int(value(i));
+    w.EndArray();
+  };
+  auto numbers = [&](const char* key, auto count, auto value) {
+    w.Key(key);
+    w.StartArray();
+    for (size_t i = 0; i < static_cast<size_t>(count); ++i) json::writeNumber(w, value(i));
+    w.EndArray();
+  };
+  w.StartObject();
+  w.Key("format");
+  w.String("json");
+  w.Key("scheme");
+  w.String(mesh.scheme == Scheme::Loop       ? "loop"
+           : mesh.scheme == Scheme::Bilinear ? "bilinear"
+                                             : "catmull-clark");
+  w.Key("points");
+  w.StartArray();
+  for (const auto& p : mesh.points) {
+    w.StartArray();
+    for (int k = 0; k < 3; ++k) json::writeNumber(w, p[k]);
+    w.EndArray();
+  }
+  w.EndArray();
+  ints("faceVertexCounts", mesh.faceVertexCounts.size(),
+       [&](size_t i) { return mesh.faceVertexCounts[i]; });
+  ints("faceVertexIndices", mesh.faceVertexIndices.size(),
+       [&](size_t i) { return mesh.faceVertexIndices[i]; });
+  if (!mesh.creases.empty()) {
+    ints("creaseIndices", 2 * mesh.creases.size(),
+         [&](size_t i) { return i % 2 ? mesh.creases[i / 2].v1 : mesh.creases[i / 2].v0; });
+    ints("creaseLengths", mesh.creases.size(), [](size_t) { return 2; });
+    numbers("creaseSharpnesses", mesh.creases.size(),
+            [&](size_t i) { return mesh.creases[i].sharpness; });
+  }
+  if (!mesh.corners.empty()) {
+    ints("cornerIndices", mesh.corners.size(), [&](size_t i) { return mesh.corners[i].vertex; });
+    numbers("cornerSharpnesses", mesh.corners.size(),
+            [&](size_t i) { return mesh.corners[i].sharpness; });
+  }
+  if (!mesh.holes.empty()) {
+    ints("holeIndices", mesh.holes.size(), [&](size_t i) { return mesh.holes[i]; });
+  }
+  w.Key("interpolateBoundary");
+  w.String(mesh.boundary == BoundaryInterpolation::None       ? "none"
+           : mesh.boundary == BoundaryInterpolation::EdgeOnly ? "edge-only"
+                                                              : "edge-and-corner");
+  w.Key("creaseMethod");
+  w.String(mesh.creaseMethod == CreaseMethod::Chaikin ? "chaikin" : "uniform");
+  w.Key("triangleSubdivision");
+  w.String(mesh.triangleSubdivision == TriangleSubdivision::Smooth ? "smooth" : "catmull-clark");
+  w.EndObject();
+  return {buffer.GetString(), buffer.GetSize()};
+}
+
 }  // namespace limn::api

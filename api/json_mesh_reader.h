@@ -1,4 +1,4 @@
-// The JSON mesh form with USD's mesh attribute names -> ControlMesh:
+// The JSON mesh form with USD's mesh attribute names -> ControlMesh (and back):
 //   scheme, points, faceVertexCounts, faceVertexIndices, creaseIndices, creaseLengths,
 //   creaseSharpnesses, cornerIndices, cornerSharpnesses, holeIndices, interpolateBoundary,
 //   creaseMethod, triangleSubdivision.
@@ -21,6 +21,10 @@ namespace limn::api {
 // render::InputError (InvalidMesh, LimitExceeded) for a mesh that cannot be used.
 render::mesh::ControlMesh readJsonMesh(const rapidjson::Value& object, const std::string& field,
                                        const render::mesh::MeshLimits& limits);
+
+// `mesh` in the same form (creases as one 2-vertex chain per edge, each with its sharpness):
+// readJsonMesh gives the same mesh back, with the same contentHash.
+std::string writeJsonMesh(const render::mesh::ControlMesh& mesh);
 
 // The scheme names of both mesh forms: "catmull-clark" | "loop" | "bilinear" (USD's
 // "catmullClark" is accepted too).

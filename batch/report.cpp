@@ -127,33 +127,40 @@ std::vector<std::string> csvColumns() {
   return columns;
 }
 
+std::string csvHeader() {
+  std::string line;
+  for (const std::string& column : csvColumns()) line += (line.empty() ? "" : ",") + column;
+  return line + "\n";
+}
+
+std::string csvLine(const api::ResultRow& r) {
+  std::vector<std::string> fields = {r.key,
+                                     r.mesh,
+                                     r.meshPath,
+                                     r.meshHash,
+                                     r.label,
+                                     r.method,
+                                     r.params,
+                                     r.shading,
+                                     r.view,
+                                     std::to_string(r.size),
+                                     std::to_string(r.supersample)};
+  fields.push_back(r.error ? "" : numberText(r.triangles));
+  fields.push_back(r.error ? "" : numberText(r.controlFaces));
+  for (const char* c : kMetricColumns) fields.push_back(optionalNumber(r.metrics, c));
+  for (const char* c : kTimingColumns) fields.push_back(optionalNumber(r.timings, c));
+  fields.push_back(r.error ? std::to_string(r.error->status) : "");
+  fields.push_back(r.error ? r.error->code : "");
+  fields.push_back(r.error ? r.error->message : "");
+  std::string line;
+  for (size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + csvField(fields[i]);
+  return line + "\n";
+}
+
 void writeCsv(const std::vector<api::ResultRow>& rows, const fs::path& file) {
   std::ofstream out(file);
-  std::vector<std::string> columns = csvColumns();
-  for (size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
-  out << "\n";
-  for (const api::ResultRow& r : rows) {
-    std::vector<std::string> fields = {r.key,
-                                       r.mesh,
-                                       r.meshPath,
-                                       r.meshHash,
-                                       r.label,
-                                       r.method,
-                                       r.params,
-                                       r.shading,
-                                       r.view,
-                                       std::to_string(r.size),
-                                       std::to_string(r.supersample)};
-    fields.push_back(r.error ? "" : numberText(r.triangles));
-    fields.push_back(r.error ? "" : numberText(r.controlFaces));
-    for (const char* c : kMetricColumns) fields.push_back(optionalNumber(r.metrics, c));
-    for (const char* c : kTimingColumns) fields.push_back(optionalNumber(r.timings, c));
-    fields.push_back(r.error ? std::to_string(r.error->status) : "");
-    fields.push_back(r.error ? r.error->code : "");
-    fields.push_back(r.error ? r.error->message : "");
-    for (size_t i = 0; i < fields.size(); ++i) out << (i ? "," : "") << csvField(fields[i]);
-    out << "\n";
-  }
+  out << csvHeader();
+  for (const api::ResultRow& r : rows) out << csvLine(r);
   if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 

@@ -30,6 +30,10 @@ std::set<std::string> finishedKeys(const std::vector<api::ResultRow>& rows);
 // The CSV columns: the row's place, then every metric, timing and error field.
 std::vector<std::string> csvColumns();
 void writeCsv(const std::vector<api::ResultRow>& rows, const std::filesystem::path& file);
+// The same file a piece at a time (GET /v1/jobs/{id}/results.csv): the header, then a line per
+// row, each ending in a newline.
+std::string csvHeader();
+std::string csvLine(const api::ResultRow& row);
 
 // Per method label (the table of summary.md and report.html).
 struct MethodSummary {

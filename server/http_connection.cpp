@@ -134,6 +134,12 @@ void Connection::onBody(error_code ec) {
   handle();
 }
 
+std::string Connection::peerAddress() const {
+  error_code ec;
+  const auto peer = socket_.remote_endpoint(ec);
+  return ec ? std::string("unknown") : peer.address().to_string();
+}
+
 void Connection::handle() {
   phase_ = Phase::Handling;
   auto message = parser_->release();
@@ -145,7 +151,9 @@ void Connection::handle() {
                   std::string(message[http::field::accept]),
                   std::string(message[http::field::authorization]),
                   std::string(message[http::field::origin]),
-                  requestId_};
+                  requestId_,
+                  std::string(message["Idempotency-Key"]),
+                  peerAddress()};
   // The router may answer from a worker thread: hop back onto this connection's strand.
   const unsigned generation = ++handling_;
   abandon_ = shared_.router.handle(

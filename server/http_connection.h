@@ -92,6 +92,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void readBody();
   void onBody(boost::system::error_code ec);
   void handle();
+  // The client's IP address, for GET /v1/jobs' "your jobs" when no token names the caller.
+  std::string peerAddress() const;
   // While handling: waits for the socket to turn readable, then tells end of stream (the client
   // went away: abandon the job) from the next request's first bytes (keep waiting for nothing).
   void watchForHangUp(unsigned generation);

@@ -1,13 +1,19 @@
-// JobManager: POST /v1/jobs — a batch spec run in the background — GET /v1/jobs/{id} (state,
-// progress, the rows so far) and DELETE /v1/jobs/{id} (cancel; a finished job is forgotten).
+// JobManager: the HTTP side of batch jobs over a batch::JobStore (SQLite or PostgreSQL) —
+// POST /v1/jobs (with Idempotency-Key), GET /v1/jobs (the caller's jobs), GET and DELETE
+// /v1/jobs/{id}, GET /v1/jobs/{id}/results.csv and results.jsonl — and this replica's share of
+// computing them.
 //
-// Jobs run one at a time, in the order they came, on one driver thread that sends their row
-// groups to the server's own WorkerPool through batch::runGroups (as many in flight as there are
-// workers): a job's comparisons wait in the same queue, under the same limits and deadline, as
-// any /v1/compare, and an interactive request waits behind at most one group per worker. The
-// table holds at most `maxJobs` jobs; a new one evicts the oldest finished job when the table is
-// full, and is refused 429 when every held job is still queued or running. Finished jobs are
-// kept `retention` for their client to read, then dropped. Thread-safe.
+// Every replica on the same store answers for every job, and each one's runner thread claims
+// row groups from the store while the render pool has a free worker and no request waiting for
+// one (interactive requests come first), sends each as a /v1/compare task to the pool, and
+// stores its rows. Leases are renewed every lease/3; a replica that dies leaves its groups to be
+// claimed again when their leases run out. A group that comes back busy, timed out or refused
+// (429, 503, 504) is given back with a growing pause, up to maxAttempts claims; one that
+// crashed its worker twice is stored as error rows naming the crash. On shutdown the runner
+// gives its leases back, uncounted, for the next replica or restart.
+//
+// A store that cannot be reached makes /v1/jobs answer 503 (Retry-After) and healthy() false
+// (/readyz); renders go on, and the runner keeps trying it. Thread-safe.
 #pragma once
 
 #include <chrono>
@@ -20,6 +26,8 @@
 #include <thread>
 
 #include "api/answer.h"
+#include "api/batch_plan.h"
+#include "batch/job_store.h"
 #include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
 #include "server/worker_pool.h"
@@ -27,54 +35,78 @@
 namespace limn::server {
 
 struct JobOptions {
-  size_t maxJobs = 8;                    // jobs held: queued, running and finished
-  size_t maxJobRows = 20000;             // rows of one job (each is about 1.5 kB held)
+  size_t maxJobs = 8;                    // jobs held in the store: queued, running and finished
+  size_t maxJobRows = 20000;             // rows of one job
   std::chrono::seconds retention{3600};  // a finished job is kept this long
+  int maxAttempts = 4;                   // claims of one group before its rows are errors
+  std::chrono::milliseconds poll{500};   // an idle runner asks the store for work this often
 };
+
+// Who is asking, for GET /v1/jobs and Idempotency-Key: a digest of the bearer token when the
+// request carries one, else the peer's address.
+std::string clientOf(const std::string& authorization, const std::string& peer);
 
 class JobManager {
  public:
-  // `pool` and `meshes` (may be null) must outlive the manager; stop() before the pool stops.
+  // `pool`, `meshes` (may be null) must outlive the manager; stop() before the pool stops.
   JobManager(WorkerPool& pool, const render::pipeline::JobLimits& limits, JobOptions options,
-             render::mesh::MeshCache* meshes = nullptr);
+             std::unique_ptr<batch::JobStore> store, render::mesh::MeshCache* meshes = nullptr);
   ~JobManager();  // stop()
   JobManager(const JobManager&) = delete;
   JobManager& operator=(const JobManager&) = delete;
 
-  // 202 with the job, or the spec's 4xx, or 429 when the table is full of unfinished jobs.
-  // Parses the spec's meshes: call it on a worker (the router does), not an IO thread.
-  api::Answer create(std::string_view body);
+  // 202 with the job (200 with the same job for a repeated Idempotency-Key), the spec's 4xx,
+  // 422 for a key reused with another body, 429 when maxJobs unfinished jobs are held. Parses
+  // the spec's meshes: call it on a worker (the router does), not an IO thread.
+  api::Answer create(std::string_view body, const std::string& client,
+                     const std::string& idempotencyKey);
   // 200 with the job and its rows from `offset` on, or 404 not_found.
   api::Answer get(const std::string& id, size_t offset);
-  // Cancels a queued or running job (200, state "cancelled", its rows so far kept until the
-  // retention ends), or forgets a finished one (200 with its last state); 404 for an unknown id.
+  // 200 with the client's jobs, newest first, `limit` a page from the cursor `after`.
+  api::Answer list(const std::string& client, const std::string& after, size_t limit);
+  // Cancels a queued or running job (200, state "cancelled", its rows kept until the retention
+  // ends), or forgets a finished one (200 with its last state); 404 for an unknown id.
   api::Answer cancel(const std::string& id);
+  // The job's rows as results.jsonl ("jsonl") or results.csv ("csv"), in row order.
+  api::Answer results(const std::string& id, const std::string& format);
 
-  // Cancels every job and waits for the driver thread.
+  // Whether the store answered its last round trip.
+  bool healthy() const;
+  const std::string& replica() const { return store_->replica(); }
+
+  // Stops claiming, gives up the comparisons in flight, hands their leases back, and waits
+  // for the runner thread.
   void stop();
 
  private:
-  struct Job;
-  void driverLoop();
-  void runJob(Job& job);
-  // Drops the finished jobs past their retention.
-  void dropExpiredLocked();
-  // For a new job: dropExpiredLocked(), then, while the table is full, the oldest finished
-  // job; false when it stays full (every job unfinished).
-  bool makeRoomLocked();
-  api::Answer viewLocked(const Job& job, size_t offset, int status) const;
+  struct InFlight;
+  struct Finished;
+  void runLoop();
+  // Claims groups while the pool has room; false when the store had none.
+  bool claimWork();
+  void startGroup(batch::ClaimedGroup group);
+  void settle(Finished finished);
+  void heartbeat();
+  std::shared_ptr<const api::BatchPlan> planOf(const std::string& jobId);
+  // Runs a store call; a lost store is 503, and marks the store unhealthy until a ping works.
+  template <typename Fn>
+  api::Answer withStore(Fn&& fn);
+  api::Answer viewOf(const batch::JobRecord& job, size_t offset, int status, bool withRows);
 
   WorkerPool& pool_;
   render::pipeline::JobLimits limits_;
   JobOptions options_;
+  std::unique_ptr<batch::JobStore> store_;
   render::mesh::MeshCache* meshes_;
 
   mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  std::map<std::string, std::shared_ptr<Job>> jobs_;
-  std::deque<std::shared_ptr<Job>> queue_;
-  bool stopping_ = false;
-  std::thread driver_;
+  std::condition_variable wake_;
+  bool stopping_ = false, healthy_ = true;
+  bool workAdded_ = false;  // a job was created here: claim at once rather than at the next poll
+  std::map<std::pair<std::string, size_t>, std::shared_ptr<InFlight>> inFlight_;
+  std::deque<Finished> finished_;
+  std::map<std::string, std::shared_ptr<const api::BatchPlan>> plans_;  // a few recent jobs
+  std::thread runner_;
 };
 
 }  // namespace limn::server

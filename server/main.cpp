@@ -19,12 +19,14 @@
 #include "api/config.h"
 #include "api/implicit_api.h"
 #include "api/render_api.h"
+#include "batch/job_store.h"
 #include "render/core/error.h"
 #include "render/image/encode.h"
 #include "render/pipeline/render_job.h"
 #include "render/raster/rasterizer.h"
 #include "server/batch_command.h"
 #include "server/http_server.h"
+#include "server/jobs.h"
 #include "server/router.h"
 #include "server/tasks.h"
 #include "server/worker_pool.h"
@@ -42,7 +44,7 @@ constexpr const char* kHelp =
     R"(limn )" LIMN_VERSION R"( - renders smooth (subdivision) surfaces over HTTP
 
 Usage:
-  limn serve [--listen HOST:PORT] [--config FILE] [--workers N]
+  limn serve [--listen HOST:PORT] [--config FILE] [--workers N] [--job-store STORE]
       Runs the HTTP service. Defaults: 127.0.0.1:8080, built-in configuration, one render
       worker per core. Port 0 picks a free port. Once it accepts connections it prints
         limn listening on http://HOST:PORT
@@ -51,9 +53,12 @@ Usage:
       curves of the limit surface as JSON polylines or SVG, pieces marked visible or hidden),
       POST /v1/meshes (a mesh kept for later requests by id), POST /v1/tessellate (the
       approximation as glTF, PLY or OBJ), POST /v1/compare (several methods against one
-      reference per camera), POST /v1/jobs, GET and DELETE /v1/jobs/{id} (a batch spec run
-      in the background), GET / (the web page: open it in a browser), /examples, /healthz,
-      /readyz, /metrics, /openapi.json.
+      reference per camera), POST /v1/jobs, GET /v1/jobs, GET and DELETE /v1/jobs/{id},
+      GET /v1/jobs/{id}/results.csv|jsonl (a batch spec run in the background), GET / (the
+      web page: open it in a browser), /examples, /healthz, /readyz, /metrics, /openapi.json.
+      Jobs are kept in STORE: sqlite:PATH or a postgresql:// URI shared by several replicas
+      (else LIMN_JOB_STORE, else the configuration's jobStore, else
+      sqlite:$LIMN_DATA_DIR/jobs.sqlite, LIMN_DATA_DIR defaulting to ~/.local/state/limn).
 
   limn render REQUEST.json --out DIR [--config FILE]
       Runs one /v1/render request body through the engine without HTTP and writes
@@ -117,7 +122,7 @@ std::optional<std::string> readFile(const std::string& path) {
 // Options shared by both commands; each parses its own positional arguments.
 struct CommandLine {
   std::vector<std::string> positional;
-  std::optional<std::string> listen, config, workers, out;
+  std::optional<std::string> listen, config, workers, out, jobStore;
 };
 
 std::optional<CommandLine> parseArguments(int argc, char** argv, int first, std::string& error) {
@@ -129,6 +134,7 @@ std::optional<CommandLine> parseArguments(int argc, char** argv, int first, std:
     if (arg == "--config") target = &cl.config;
     if (arg == "--workers") target = &cl.workers;
     if (arg == "--out") target = &cl.out;
+    if (arg == "--job-store") target = &cl.jobStore;
     if (target) {
       if (i + 1 >= argc) {
         error = arg + " needs a value";
@@ -165,6 +171,34 @@ std::optional<api::ServiceConfig> loadConfiguration(const CommandLine& cl) {
     std::cerr << "limn: configuration " << *path << ": " << e.what() << "\n";
   }
   return std::nullopt;
+}
+
+// --job-store, else LIMN_JOB_STORE, else the configuration's jobStore, else a SQLite file in
+// the data folder: LIMN_DATA_DIR, else $XDG_STATE_HOME/limn, else ~/.local/state/limn.
+std::string jobStoreLocation(const CommandLine& cl, const api::ServiceConfig& config) {
+  if (cl.jobStore) return *cl.jobStore;
+  if (auto store = environment("LIMN_JOB_STORE")) return *store;
+  if (!config.jobStore.empty()) return config.jobStore;
+  std::string folder;
+  if (auto data = environment("LIMN_DATA_DIR")) {
+    folder = *data;
+  } else if (auto state = environment("XDG_STATE_HOME")) {
+    folder = *state + "/limn";
+  } else if (auto home = environment("HOME")) {
+    folder = *home + "/.local/state/limn";
+  } else {
+    folder = "limn-data";
+  }
+  return "sqlite:" + folder + "/jobs.sqlite";
+}
+
+// The name this process's rows and leases carry: LIMN_REPLICA, else host name and pid (a
+// restarted process is another replica: the leases of the one before simply run out).
+std::string replicaName() {
+  if (auto name = environment("LIMN_REPLICA")) return *name;
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0) std::snprintf(host, sizeof host, "limn");
+  return std::string(host) + "-" + std::to_string(::getpid());
 }
 
 int serve(const CommandLine& cl) {
@@ -218,10 +252,23 @@ int serve(const CommandLine& cl) {
     if (const char* token = std::getenv("LIMN_AUTH_TOKEN"); token && *token)
       access.authToken = token;
   }
-  server::JobManager jobs(
-      pool, config->limits,
-      {config->maxJobs, config->maxJobRows, std::chrono::seconds(config->jobRetentionSeconds)},
-      &meshCache);
+  // A store that cannot be opened ends the start, naming it: a replica that silently ran
+  // without its jobs would answer 404 for every job of the cluster.
+  const std::string storeLocation = jobStoreLocation(cl, *config);
+  std::unique_ptr<batch::JobStore> store;
+  try {
+    store = batch::JobStore::open(storeLocation, replicaName(),
+                                  {std::chrono::seconds(config->jobLeaseSeconds)});
+  } catch (const std::exception& e) {
+    std::cerr << "limn: job store: " << e.what() << "\n";
+    return 1;
+  }
+  std::cerr << "limn: jobs in " << store->describe() << " (replica " << store->replica() << ")\n";
+  server::JobOptions jobOptions;
+  jobOptions.maxJobs = config->maxJobs;
+  jobOptions.maxJobRows = config->maxJobRows;
+  jobOptions.retention = std::chrono::seconds(config->jobRetentionSeconds);
+  server::JobManager jobs(pool, config->limits, jobOptions, std::move(store), &meshCache);
   server::Router router(config->limits, pool, metrics, access, config->logLevel, &meshCache, &jobs);
   server::HttpOptions httpOptions;
   httpOptions.host = config->host;
@@ -268,7 +315,8 @@ int fail(const api::ApiError& error, int status) {
 int renderCommand(const CommandLine& cl) {
   if (cl.positional.size() != 1) return usageError("render wants one REQUEST.json");
   if (!cl.out) return usageError("render wants --out DIR");
-  if (cl.listen || cl.workers) return usageError("--listen and --workers belong to limn serve");
+  if (cl.listen || cl.workers || cl.jobStore)
+    return usageError("--listen, --workers and --job-store belong to limn serve");
   auto config = loadConfiguration(cl);
   if (!config) return 1;
   auto text = readFile(cl.positional[0]);

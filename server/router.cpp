@@ -40,35 +40,57 @@ const Router::Route Router::kRoutes[] = {
     {"POST", "/v1/compare", &Router::compute, Endpoint::Compare},
     {"POST", "/v1/meshes", &Router::uploadMesh},
     {"POST", "/v1/jobs", &Router::createJob},
+    {"GET", "/v1/jobs", &Router::listJobs},
     {"GET", "/v1/jobs/{id}", &Router::getJob},
     {"DELETE", "/v1/jobs/{id}", &Router::cancelJob},
+    {"GET", "/v1/jobs/{id}/results.csv", &Router::jobResults},
+    {"GET", "/v1/jobs/{id}/results.jsonl", &Router::jobResults},
 };
 
 namespace {
 
 constexpr std::string_view kJobPrefix = "/v1/jobs/";
 
-// The path as the route table names it: /v1/jobs/<id> is "/v1/jobs/{id}".
+// The path as the route table names it: /v1/jobs/<id> is "/v1/jobs/{id}", and
+// /v1/jobs/<id>/results.csv is "/v1/jobs/{id}/results.csv".
 std::string_view routePath(std::string_view path) {
-  if (path.size() > kJobPrefix.size() && path.substr(0, kJobPrefix.size()) == kJobPrefix &&
-      path.find('/', kJobPrefix.size()) == std::string_view::npos) {
-    return "/v1/jobs/{id}";
+  if (path.size() <= kJobPrefix.size() || path.substr(0, kJobPrefix.size()) != kJobPrefix) {
+    return path;
   }
+  const size_t slash = path.find('/', kJobPrefix.size());
+  if (slash == std::string_view::npos) return "/v1/jobs/{id}";
+  const std::string_view rest = path.substr(slash);
+  if (rest == "/results.csv") return "/v1/jobs/{id}/results.csv";
+  if (rest == "/results.jsonl") return "/v1/jobs/{id}/results.jsonl";
   return path;
 }
 
-// "offset" of a query string ("?offset=20"), 0 when absent or not a number.
-size_t offsetParameter(std::string_view target) {
+// A query parameter's value ("" when absent).
+std::string queryParameter(std::string_view target, std::string_view name) {
   const size_t query = target.find('?');
-  if (query == std::string_view::npos) return 0;
+  if (query == std::string_view::npos) return "";
   std::string_view rest = target.substr(query + 1);
-  const size_t at = rest.find("offset=");
-  if (at == std::string_view::npos || (at > 0 && rest[at - 1] != '&')) return 0;
+  while (!rest.empty()) {
+    const std::string_view pair = rest.substr(0, rest.find('&'));
+    if (pair.size() > name.size() && pair.substr(0, name.size()) == name &&
+        pair[name.size()] == '=') {
+      return std::string(pair.substr(name.size() + 1));
+    }
+    if (pair.size() == rest.size()) break;
+    rest.remove_prefix(pair.size() + 1);
+  }
+  return "";
+}
+
+// A whole-number query parameter, `fallback` when absent or not a number, at most `most`.
+size_t numberParameter(std::string_view target, std::string_view name, size_t fallback,
+                       size_t most) {
+  const std::string text = queryParameter(target, name);
+  if (text.empty()) return fallback;
   size_t value = 0;
-  for (char c : rest.substr(at + 7)) {
-    if (c < '0' || c > '9') break;
-    value = value * 10 + static_cast<size_t>(c - '0');
-    if (value > (size_t{1} << 40)) break;
+  for (char c : text) {
+    if (c < '0' || c > '9') return fallback;
+    value = std::min(value * 10 + static_cast<size_t>(c - '0'), most);
   }
   return value;
 }
@@ -94,7 +116,8 @@ api::Answer noJobs(const Request& request) {
 }
 
 std::string jobId(const Request& request) {
-  return std::string(pathOf(request.target).substr(kJobPrefix.size()));
+  std::string_view rest = pathOf(request.target).substr(kJobPrefix.size());
+  return std::string(rest.substr(0, rest.find('/')));
 }
 
 }  // namespace
@@ -203,20 +226,41 @@ WorkerPool::Abandon Router::uploadMesh(const Route&, Request& request, Reply& re
 // (server/jobs.h).
 WorkerPool::Abandon Router::createJob(const Route&, Request& request, Reply& reply) {
   if (!jobs_) return answerNow(reply, noJobs(request));
-  return pool_.submitInServer([jobs = jobs_, body = std::move(request.body)](
-                                  render::pipeline::RenderContext&,
-                                  const render::CancelToken&) { return jobs->create(body); },
-                              std::move(reply));
+  return pool_.submitInServer(
+      [jobs = jobs_, body = std::move(request.body),
+       client = clientOf(request.authorization, request.peer),
+       key = std::move(request.idempotencyKey)](render::pipeline::RenderContext&,
+                                                const render::CancelToken&) {
+        return jobs->create(body, client, key);
+      },
+      std::move(reply));
 }
 
 WorkerPool::Abandon Router::getJob(const Route&, Request& request, Reply& reply) {
   if (!jobs_) return answerNow(reply, noJobs(request));
-  return answerNow(reply, jobs_->get(jobId(request), offsetParameter(request.target)));
+  return answerNow(reply, jobs_->get(jobId(request), numberParameter(request.target, "offset", 0,
+                                                                     size_t{1} << 40)));
+}
+
+WorkerPool::Abandon Router::listJobs(const Route&, Request& request, Reply& reply) {
+  if (!jobs_) return answerNow(reply, noJobs(request));
+  constexpr size_t kDefaultPage = 50, kLargestPage = 500;
+  return answerNow(
+      reply, jobs_->list(clientOf(request.authorization, request.peer),
+                         queryParameter(request.target, "after"),
+                         std::max<size_t>(1, numberParameter(request.target, "limit", kDefaultPage,
+                                                             kLargestPage))));
 }
 
 WorkerPool::Abandon Router::cancelJob(const Route&, Request& request, Reply& reply) {
   if (!jobs_) return answerNow(reply, noJobs(request));
   return answerNow(reply, jobs_->cancel(jobId(request)));
+}
+
+WorkerPool::Abandon Router::jobResults(const Route& route, Request& request, Reply& reply) {
+  if (!jobs_) return answerNow(reply, noJobs(request));
+  const bool csv = route.path.substr(route.path.size() - 4) == ".csv";
+  return answerNow(reply, jobs_->results(jobId(request), csv ? "csv" : "jsonl"));
 }
 
 WorkerPool::Abandon Router::openApi(const Route&, Request&, Reply& reply) {
@@ -302,6 +346,8 @@ WorkerPool::Abandon Router::readyz(const Route&, Request&, Reply& reply) {
     reason = "no render worker has an OpenGL context";
   } else if (pool.queued >= pool.queueCapacity) {
     reason = "render queue full";
+  } else if (jobs_ && !jobs_->healthy()) {
+    reason = "the job store cannot be reached";
   }
   if (reason.empty()) return answerNow(reply, jsonAnswer(200, "{\"ready\":true}"));
   return answerNow(reply, jsonAnswer(503, "{\"ready\":false,\"reason\":" +

@@ -7,14 +7,15 @@
 // access.h's rules (bearer token, CORS) come first. Tests call it directly.
 //
 //   GET  /healthz       liveness, what the workers run on, each worker's state
-//   GET  /readyz        200 when a render would be accepted now, else 503
+//   GET  /readyz        200 when a render would be accepted now and the job store answers, else 503
 //   GET  /metrics       Prometheus text format
 //   GET  /openapi.json  the API description
 //   POST /v1/render, /v1/silhouette, /v1/tessellate, /v1/implicit, /v1/compare
 //                       a Task on a render worker (one queue, one set of limits and deadlines)
 //   POST /v1/meshes     api::handleMeshUpload on a worker's thread in the server, into the cache
 //   POST /v1/jobs       JobManager::create on a worker's thread in the server
-//   GET, DELETE /v1/jobs/{id}   JobManager::get / cancel, at once
+//   GET  /v1/jobs, GET and DELETE /v1/jobs/{id}, GET /v1/jobs/{id}/results.{csv,jsonl}
+//                       JobManager::list / get / cancel / results, at once (store reads)
 //   GET  /, /NAME.js, /examples, /examples/NAME   the built-in page and examples (web_assets.h)
 #pragma once
 
@@ -40,9 +41,11 @@ struct Request {
   std::string target;  // path, possibly with "?query"
   std::string body;
   std::string accept = {};  // the Accept header ("" when absent): /v1/silhouette may answer SVG
-  std::string authorization = {};  // the Authorization header ("" when absent)
-  std::string origin = {};         // the Origin header ("" when absent)
-  uint64_t id = 0;                 // the X-Request-Id its answer will carry
+  std::string authorization = {};   // the Authorization header ("" when absent)
+  std::string origin = {};          // the Origin header ("" when absent)
+  uint64_t id = 0;                  // the X-Request-Id its answer will carry
+  std::string idempotencyKey = {};  // the Idempotency-Key header ("" when absent): POST /v1/jobs
+  std::string peer = {};            // the client's address ("" in tests without a socket)
 };
 
 class Router {
@@ -84,7 +87,9 @@ class Router {
   WorkerPool::Abandon uploadMesh(const Route&, Request& request, Reply& reply);
   WorkerPool::Abandon createJob(const Route&, Request& request, Reply& reply);
   WorkerPool::Abandon getJob(const Route&, Request& request, Reply& reply);
+  WorkerPool::Abandon listJobs(const Route&, Request& request, Reply& reply);
   WorkerPool::Abandon cancelJob(const Route&, Request& request, Reply& reply);
+  WorkerPool::Abandon jobResults(const Route&, Request& request, Reply& reply);
   api::Answer webAsset(const EmbeddedFile& file) const;
 
   WorkerPool::Abandon route(Request request, Reply reply);

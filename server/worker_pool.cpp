@@ -589,6 +589,7 @@ PoolSnapshot WorkerPool::snapshot() const {
   s.queued = queue_.size();
   s.queueCapacity = options_.queueDepth;
   s.stopping = stopping_;
+  s.draining = draining_;
   s.renderCount = renderCount_;
   s.rejectedBusy = rejectedBusy_;
   s.timedOut = timedOut_;

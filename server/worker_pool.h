@@ -103,6 +103,7 @@ struct PoolSnapshot {
   size_t queued = 0;
   size_t queueCapacity = 0;
   bool stopping = false;
+  bool draining = false;   // shutting down: new work is refused 503
   size_t renderCount = 0;  // jobs run to their end
   size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
   size_t abandoned = 0;     // jobs whose client went away before their answer

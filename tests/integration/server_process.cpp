@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -29,6 +30,10 @@ ServerProcess::ServerProcess(const std::vector<std::string>& extraArgs,
   std::vector<std::string> args{limnBinary(), "serve"};
   if (loopbackListen) args.insert(args.end(), {"--listen", "127.0.0.1:0"});
   args.insert(args.end(), extraArgs.begin(), extraArgs.end());
+  // Each server keeps its jobs to itself unless the test names a store to share.
+  if (std::find(extraArgs.begin(), extraArgs.end(), "--job-store") == extraArgs.end()) {
+    args.insert(args.end(), {"--job-store", "sqlite::memory:"});
+  }
 
   // Everything the child needs is allocated before fork(): only exec-safe calls after it.
   std::vector<char*> argv;
@@ -86,6 +91,10 @@ ServerProcess ServerProcess::withConfig(const std::string& configJson,
   std::string path = writeTempFile(configJson, ".json");
   std::vector<std::string> args{"--config", path};
   args.insert(args.end(), extraArgs.begin(), extraArgs.end());
+  // Each server keeps its jobs to itself unless the test names a store to share.
+  if (std::find(extraArgs.begin(), extraArgs.end(), "--job-store") == extraArgs.end()) {
+    args.insert(args.end(), {"--job-store", "sqlite::memory:"});
+  }
   try {
     ServerProcess server(args);
     server.configPath_ = path;
