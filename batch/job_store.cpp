@@ -142,9 +142,12 @@ void JobStore::migrate() {
                    : db.query("SELECT name FROM sqlite_master WHERE type = 'table'");
       bool hasSchema = false, hasOurs = false, hasOthers = false;
       for (const SqlRow& t : tables) {
-        if (t[0] == "limn_schema") hasSchema = true;
-        else if (t[0].rfind("limn_", 0) == 0) hasOurs = true;
-        else hasOthers = true;
+        if (t[0] == "limn_schema")
+          hasSchema = true;
+        else if (t[0].rfind("limn_", 0) == 0)
+          hasOurs = true;
+        else
+          hasOthers = true;
       }
       // A file is limn's alone; a PostgreSQL database may hold other programs' tables too.
       if (!hasSchema && (hasOurs || (hasOthers && !postgres))) {
@@ -195,8 +198,7 @@ CreateOutcome JobStore::create(const NewJob& job, size_t maxJobs,
       const int64_t now = nowMs();
       expireLocked(now - retention.count());
       for (;;) {
-        if (static_cast<size_t>(toInt(db.query("SELECT COUNT(*) FROM limn_jobs")[0][0])) <
-            maxJobs)
+        if (static_cast<size_t>(toInt(db.query("SELECT COUNT(*) FROM limn_jobs")[0][0])) < maxJobs)
           break;
         const auto oldest = db.query(
             "SELECT id FROM limn_jobs WHERE finished_ms <> 0 ORDER BY finished_ms LIMIT 1");
@@ -313,9 +315,9 @@ void JobStore::deleteJobsLocked(const std::string& where, const std::vector<SqlP
 }
 
 size_t JobStore::expireLocked(int64_t before) {
-  const size_t count = static_cast<size_t>(toInt(
-      db_->query("SELECT COUNT(*) FROM limn_jobs WHERE finished_ms <> 0 AND finished_ms < ?",
-                 {before})[0][0]));
+  const size_t count = static_cast<size_t>(
+      toInt(db_->query("SELECT COUNT(*) FROM limn_jobs WHERE finished_ms <> 0 AND finished_ms < ?",
+                       {before})[0][0]));
   if (count) deleteJobsLocked("finished_ms <> 0 AND finished_ms < ?", {before});
   return count;
 }
@@ -341,19 +343,21 @@ std::optional<ClaimedGroup> JobStore::claim() {
       std::vector<SqlRow> claimed;
       if (db.dialect() == SqlDialect::Postgres) {
         // Replicas claiming at once skip each other's locked rows instead of waiting on them.
-        claimed = db.query(
-            "WITH next AS (" + freeGroup + " FOR UPDATE OF g SKIP LOCKED)"
-            " UPDATE limn_job_groups AS u SET state = 'leased', lease_owner = ?,"
-            " lease_until_ms = ?, attempts = u.attempts + 1 FROM next"
-            " WHERE u.job_id = next.job_id AND u.group_index = next.group_index"
-            " RETURNING u.job_id, u.group_index, u.row_indices, u.attempts",
-            {now, now, replica_, now + options_.lease.count()});
+        claimed = db.query("WITH next AS (" + freeGroup +
+                               " FOR UPDATE OF g SKIP LOCKED)"
+                               " UPDATE limn_job_groups AS u SET state = 'leased', lease_owner = ?,"
+                               " lease_until_ms = ?, attempts = u.attempts + 1 FROM next"
+                               " WHERE u.job_id = next.job_id AND u.group_index = next.group_index"
+                               " RETURNING u.job_id, u.group_index, u.row_indices, u.attempts",
+                           {now, now, replica_, now + options_.lease.count()});
       } else {
         // BEGIN IMMEDIATE holds the file's write lock: one claim at a time.
         claimed = db.query(
             "UPDATE limn_job_groups SET state = 'leased', lease_owner = ?, lease_until_ms = ?,"
-            " attempts = attempts + 1 WHERE (job_id, group_index) IN (" + freeGroup + ")"
-            " RETURNING job_id, group_index, row_indices, attempts",
+            " attempts = attempts + 1 WHERE (job_id, group_index) IN (" +
+                freeGroup +
+                ")"
+                " RETURNING job_id, group_index, row_indices, attempts",
             {replica_, now + options_.lease.count(), now, now});
       }
       if (claimed.empty()) return std::nullopt;
@@ -412,11 +416,11 @@ std::vector<std::string> JobStore::heartbeat() {
         "UPDATE limn_job_groups SET lease_until_ms = ? WHERE lease_owner = ? AND state = 'leased'",
         {nowMs() + options_.lease.count(), replica_});
     std::vector<std::string> stopped;
-    for (const SqlRow& row : db.query(
-             "SELECT DISTINCT g.job_id FROM limn_job_groups g LEFT JOIN limn_jobs j"
-             " ON j.id = g.job_id WHERE g.lease_owner = ? AND g.state = 'leased'"
-             " AND (j.id IS NULL OR j.state NOT IN ('queued', 'running'))",
-             {replica_})) {
+    for (const SqlRow& row :
+         db.query("SELECT DISTINCT g.job_id FROM limn_job_groups g LEFT JOIN limn_jobs j"
+                  " ON j.id = g.job_id WHERE g.lease_owner = ? AND g.state = 'leased'"
+                  " AND (j.id IS NULL OR j.state NOT IN ('queued', 'running'))",
+                  {replica_})) {
       stopped.push_back(row[0]);
     }
     return stopped;

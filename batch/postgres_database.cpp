@@ -57,7 +57,8 @@ class PostgresDatabase : public SqlDatabase {
       throw DatabaseError("cannot connect to " + where_ + ": " + trimmed(message), true);
     }
     // Notices (e.g. "relation already exists, skipping") are not the service's log.
-    PQsetNoticeProcessor(connection_, [](void*, const char*) {}, nullptr);
+    PQsetNoticeProcessor(
+        connection_, [](void*, const char*) {}, nullptr);
   }
   ~PostgresDatabase() override { PQfinish(connection_); }
 
@@ -69,7 +70,7 @@ class PostgresDatabase : public SqlDatabase {
     texts.reserve(params.size());
     for (const SqlParam& p : params) {
       texts.push_back(std::holds_alternative<int64_t>(p) ? std::to_string(std::get<int64_t>(p))
-                                                          : std::get<std::string>(p));
+                                                         : std::get<std::string>(p));
     }
     std::vector<const char*> values;
     for (const std::string& t : texts) values.push_back(t.c_str());
@@ -104,9 +105,8 @@ class PostgresDatabase : public SqlDatabase {
   void reconnect() override {
     PQreset(connection_);
     if (PQstatus(connection_) != CONNECTION_OK) {
-      throw DatabaseError("cannot connect to " + where_ + ": " +
-                              trimmed(PQerrorMessage(connection_)),
-                          true);
+      throw DatabaseError(
+          "cannot connect to " + where_ + ": " + trimmed(PQerrorMessage(connection_)), true);
     }
   }
 

@@ -18,8 +18,7 @@
 namespace limn::batch {
 
 struct DatabaseError : std::runtime_error {
-  DatabaseError(const std::string& message, bool lost)
-      : std::runtime_error(message), lost(lost) {}
+  DatabaseError(const std::string& message, bool lost) : std::runtime_error(message), lost(lost) {}
   bool lost;
 };
 

@@ -80,8 +80,8 @@ class SqliteDatabase : public SqlDatabase {
       const std::filesystem::path parent = std::filesystem::path(path_).parent_path();
       if (!parent.empty()) std::filesystem::create_directories(parent, ignored);
     }
-    const int opened = sqlite3_open_v2(path_.c_str(), &db_,
-                                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+    const int opened =
+        sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
     if (opened != SQLITE_OK) {
       std::string message = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(opened);
       sqlite3_close_v2(db_);

@@ -94,6 +94,7 @@ api::Answer JobManager::withStore(Fn&& fn) {
     if (!e.lost) return api::errorAnswer({500, "internal", std::string("job store: ") + e.what()});
     {
       std::lock_guard lock(mutex_);
+      if (healthy_) std::cerr << "limn: job store: " << e.what() << "\n";
       healthy_ = false;
     }
     return storeUnavailable(e.what());

@@ -370,7 +370,7 @@ TEST_F(CompareServer, AJobSpecIsCheckedBeforeItIsQueued) {
   EXPECT_EQ(bad.status, 422) << bad.body;
   EXPECT_EQ(get(port(), "/v1/jobs/0123").status, 404);
   EXPECT_EQ(HttpClient(port()).request("DELETE", "/v1/jobs/0123").status, 404);
-  EXPECT_EQ(get(port(), "/v1/jobs").status, 405);
+  EXPECT_EQ(HttpClient(port()).request("PUT", "/v1/jobs").status, 405);
 }
 
 TEST_F(CompareServer, RealAnswersMatchTheOpenApiDocument) {
@@ -399,6 +399,10 @@ TEST_F(CompareServer, RealAnswersMatchTheOpenApiDocument) {
       {"GET", "/v1/jobs/" + id, "/v1/jobs/{id}", ""},
       {"GET", "/v1/jobs/" + id + "?offset=1", "/v1/jobs/{id}", ""},
       {"GET", "/v1/jobs/none", "/v1/jobs/{id}", ""},
+      {"GET", "/v1/jobs?limit=2", "/v1/jobs", ""},
+      {"GET", "/v1/jobs/" + id + "/results.csv", "/v1/jobs/{id}/results.csv", ""},
+      {"GET", "/v1/jobs/" + id + "/results.jsonl", "/v1/jobs/{id}/results.jsonl", ""},
+      {"GET", "/v1/jobs/none/results.csv", "/v1/jobs/{id}/results.csv", ""},
       {"DELETE", "/v1/jobs/" + id, "/v1/jobs/{id}", ""},
       {"DELETE", "/v1/jobs/" + id, "/v1/jobs/{id}", ""},
   };

@@ -91,10 +91,6 @@ ServerProcess ServerProcess::withConfig(const std::string& configJson,
   std::string path = writeTempFile(configJson, ".json");
   std::vector<std::string> args{"--config", path};
   args.insert(args.end(), extraArgs.begin(), extraArgs.end());
-  // Each server keeps its jobs to itself unless the test names a store to share.
-  if (std::find(extraArgs.begin(), extraArgs.end(), "--job-store") == extraArgs.end()) {
-    args.insert(args.end(), {"--job-store", "sqlite::memory:"});
-  }
   try {
     ServerProcess server(args);
     server.configPath_ = path;

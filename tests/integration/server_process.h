@@ -20,7 +20,8 @@ class ServerProcess {
   // Runs `limn serve --listen 127.0.0.1:0 <extraArgs...>` (without `--listen 127.0.0.1:0`
   // when `loopbackListen` is false: the address then comes from the environment or a
   // configuration file); throws std::runtime_error when the server exits or stays silent for
-  // `startTimeout` instead of announcing its port.
+  // `startTimeout` instead of announcing its port. Its jobs are kept in a private in-memory
+  // store (--job-store sqlite::memory:) unless `extraArgs` name a --job-store.
   explicit ServerProcess(const std::vector<std::string>& extraArgs = {},
                          std::chrono::seconds startTimeout = std::chrono::seconds(60),
                          bool loopbackListen = true);
