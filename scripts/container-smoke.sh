@@ -45,7 +45,7 @@ project="limn-smoke-compose-$$"
 compose=(podman-compose -p "$project" -f docker/compose.yaml)
 cleanup() {
   podman rm -f -t 0 "$container" >/dev/null 2>&1 || true
-  "${compose[@]}" down -t 0 >/dev/null 2>&1 || true
+  "${compose[@]}" down -v -t 0 >/dev/null 2>&1 || true
   rm -rf "$work"
 }
 trap cleanup EXIT

@@ -23,6 +23,8 @@ packages=(
   libtinyobjloader-dev libegl1-mesa-dev libgl1-mesa-dri libgles-dev libgl-dev
   libgtest-dev libgmock-dev libbenchmark-dev libxxhash-dev libspdlog-dev libmuparser-dev
   libcli11-dev
+  # the job store's two backends (batch/job_store.h)
+  libsqlite3-dev libpq-dev
 )
 if [ "$profile" = full ]; then
   packages+=(
@@ -35,6 +37,8 @@ if [ "$profile" = full ]; then
     python3-skimage
     # limn batch's plots (scripts/batch_plots.py, run by /usr/bin/python3)
     python3-matplotlib
+    # the job store tests start throwaway PostgreSQL servers (tests/support/postgres_cluster.h)
+    postgresql
   )
   # The browser tests (tests/browser): Debian's chromium, and node + npm unless a node is there.
   packages+=(chromium)

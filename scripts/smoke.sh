@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Smoke test of a running limn, for containerised CI and deployments: health, readiness, one
 # render of a shipped example with its exact reference and a bound on its silhouette error, one
-# bad request with its JSON error, and /metrics counters that moved. Needs curl and python3.
+# bad request with its JSON error, a one-row job through the job store, and /metrics counters
+# that moved. Needs curl and python3.
 #
 #   scripts/smoke.sh [URL]          (default http://127.0.0.1:8080)
 #   LIMN_AUTH_TOKEN=...             sent as a bearer token when set
@@ -70,6 +71,31 @@ status=$(status_of /v1/render -X POST -H 'Content-Type: application/json' "${aut
 /usr/bin/python3 -c 'import json,sys; e=json.load(open(sys.argv[1]))["error"]; assert e["code"] == "invalid_mesh" and "line 3" in e["message"], e' \
   "$work/body" || fail "the 422 does not name the line: $(head -c 300 "$work/body")"
 pass "bad mesh refused: $(head -c 160 "$work/body")"
+
+# A one-row job through the job store (the image's SQLite file on its volume, or PostgreSQL):
+# accepted, computed, and its rows downloadable as CSV.
+/usr/bin/python3 -c 'import json,sys
+obj = open(sys.argv[1]).read()
+print(json.dumps({"meshes": [{"name": "cube", "mesh": {"format": "obj", "data": obj}}],
+                  "methods": ["coarse"], "cameras": ["front"], "size": 32}))' \
+  examples/cube.obj >"$work/job.json"
+status=$(status_of /v1/jobs -X POST -H 'Content-Type: application/json' "${auth[@]}" \
+  --data-binary @"$work/job.json")
+[ "$status" = 202 ] || fail "POST /v1/jobs answered $status: $(head -c 300 "$work/body")"
+job=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["id"])' "$work/body")
+state=queued
+for _ in $(seq 600); do
+  status=$(status_of "/v1/jobs/$job" "${auth[@]}")
+  [ "$status" = 200 ] || fail "GET /v1/jobs/$job answered $status: $(head -c 300 "$work/body")"
+  state=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["state"])' "$work/body")
+  [ "$state" = queued ] || [ "$state" = running ] || break
+  sleep 0.1
+done
+[ "$state" = done ] || fail "the job ended $state: $(head -c 300 "$work/body")"
+status=$(status_of "/v1/jobs/$job/results.csv" "${auth[@]}")
+[ "$status" = 200 ] && [ "$(wc -l <"$work/body")" -eq 2 ] ||
+  fail "results.csv answered $status with $(wc -l <"$work/body") lines"
+pass "a one-row job through the job store: done, results.csv has its row"
 
 after=$(metric 'limn_requests_total{path="/v1/render",status="200"}')
 [ "${after%.*}" -gt "${before%.*}" ] || fail "/metrics did not count the render ($before -> $after)"

@@ -86,6 +86,13 @@ bool JobManager::healthy() const {
   return healthy_;
 }
 
+JobManager::Counters JobManager::counters() const {
+  std::lock_guard lock(mutex_);
+  Counters c = counters_;
+  c.inFlight = inFlight_.size();
+  return c;
+}
+
 template <typename Fn>
 api::Answer JobManager::withStore(Fn&& fn) {
   try {
@@ -308,41 +315,47 @@ void JobManager::runLoop() {
       lock.lock();
       nextBeat = Clock::now() + beatEvery;
     }
-    bool storeHadWork = false;
+    Claimed claimed = Claimed::Nothing;
     if (!stopping_ && healthy_) {
       lock.unlock();
-      storeHadWork = claimWork();
+      claimed = claimWork();
       lock.lock();
     }
-    // Full (or the pool busy with requests): until an answer comes. Nothing to claim: a poll.
+    // Every worker busy with this replica's groups: an answer wakes the runner. Nothing to
+    // claim, or the workers busy with requests: it looks again after a poll.
     const Clock::time_point wakeAt = std::min(
-        nextBeat, Clock::now() + (storeHadWork ? beatEvery : Clock::duration(options_.poll)));
+        nextBeat,
+        Clock::now() + (claimed == Claimed::Full ? beatEvery : Clock::duration(options_.poll)));
     wake_.wait_until(lock, wakeAt, [&] { return stopping_ || !finished_.empty() || workAdded_; });
     workAdded_ = false;
   }
 }
 
-bool JobManager::claimWork() {
+JobManager::Claimed JobManager::claimWork() {
   for (;;) {
     // Requests first: a group is claimed only for a worker that nothing waits for.
     const PoolSnapshot pool = pool_.snapshot();
-    if (pool.stopping || pool.draining) return true;
-    if (pool.busyWorkers + static_cast<int>(pool.queued) >= pool.readyWorkers) return true;
+    if (pool.stopping || pool.draining) return Claimed::Nothing;
     {
       std::lock_guard lock(mutex_);
-      if (stopping_ || static_cast<int>(inFlight_.size()) >= pool.readyWorkers) return true;
+      if (stopping_) return Claimed::Nothing;
+      if (static_cast<int>(inFlight_.size()) >= pool.readyWorkers) return Claimed::Full;
     }
-    std::optional<batch::ClaimedGroup> group;
+    if (pool.busyWorkers + static_cast<int>(pool.queued) >= pool.readyWorkers) {
+      return Claimed::PoolBusy;
+    }
     try {
-      group = store_->claim();
+      std::optional<batch::ClaimedGroup> group = store_->claim();
+      if (!group) return Claimed::Nothing;
+      // A group that cannot start (its spec unreadable here) ends its job inside; a store lost
+      // meanwhile leaves the group leased, to be claimed again when the lease runs out.
+      startGroup(std::move(*group));
     } catch (const batch::DatabaseError& e) {
       std::lock_guard lock(mutex_);
       if (healthy_) std::cerr << "limn: job store: " << e.what() << "\n";
       healthy_ = false;
-      return false;
+      return Claimed::Nothing;
     }
-    if (!group) return false;
-    startGroup(std::move(*group));
   }
 }
 
@@ -399,6 +412,11 @@ void JobManager::startGroup(batch::ClaimedGroup group) {
   flight->abandon = std::move(abandon);
 }
 
+void JobManager::count(size_t Counters::*counter) {
+  std::lock_guard lock(mutex_);
+  ++(counters_.*counter);
+}
+
 void JobManager::settle(Finished finished) {
   std::shared_ptr<InFlight> flight;
   bool stopping;
@@ -426,6 +444,7 @@ void JobManager::settle(Finished finished) {
       // 1 s, 2 s, 4 s, ...: a busy cluster gets time to drain.
       store_->release(group, std::chrono::milliseconds(1000 << std::min(group.attempts - 1, 5)),
                       true);
+      count(&Counters::retried);
       return;
     }
     std::vector<std::string> lines = api::resultLines(*flight->plan, flight->rows, answer);
@@ -436,6 +455,7 @@ void JobManager::settle(Finished finished) {
                       api::withReplica(lines[i], store_->replica()), read && read->error});
     }
     store_->complete(group, rows);
+    count(&Counters::stored);
   } catch (const batch::DatabaseError& e) {
     // The lease runs out and the group is claimed again; its rows are made once more.
     std::lock_guard lock(mutex_);

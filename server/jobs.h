@@ -72,6 +72,14 @@ class JobManager {
 
   // Whether the store answered its last round trip.
   bool healthy() const;
+  // For /metrics: this replica's row groups by what became of them, and those in flight.
+  struct Counters {
+    size_t stored = 0;    // rows stored (with or without errors)
+    size_t retried = 0;   // given back to be claimed again (busy, timeout, a crash)
+    size_t released = 0;  // given back uncounted (a shutdown, a cancelled job)
+    size_t inFlight = 0;
+  };
+  Counters counters() const;
   const std::string& replica() const { return store_->replica(); }
 
   // Stops claiming, gives up the comparisons in flight, hands their leases back, and waits
@@ -82,10 +90,12 @@ class JobManager {
   struct InFlight;
   struct Finished;
   void runLoop();
-  // Claims groups while the pool has room; false when the store had none.
-  bool claimWork();
+  // Claims groups while the pool has a worker free for them; why it stopped.
+  enum class Claimed { Nothing, Full, PoolBusy };
+  Claimed claimWork();
   void startGroup(batch::ClaimedGroup group);
   void settle(Finished finished);
+  void count(size_t Counters::*counter);
   void heartbeat();
   std::shared_ptr<const api::BatchPlan> planOf(const std::string& jobId);
   // Runs a store call; a lost store is 503, and marks the store unhealthy until a ping works.
@@ -106,6 +116,7 @@ class JobManager {
   std::map<std::pair<std::string, size_t>, std::shared_ptr<InFlight>> inFlight_;
   std::deque<Finished> finished_;
   std::map<std::string, std::shared_ptr<const api::BatchPlan>> plans_;  // a few recent jobs
+  Counters counters_;
   std::thread runner_;
 };
 

@@ -407,6 +407,20 @@ WorkerPool::Abandon Router::metricsText(const Route&, Request&, Reply& reply) {
            "# TYPE limn_reference_cache_capacity_bytes gauge\n"
         << "limn_reference_cache_capacity_bytes " << c.capacityBytes << "\n";
   }
+  if (jobs_) {
+    const JobManager::Counters c = jobs_->counters();
+    out << "# HELP limn_job_store_up Whether the job store answered its last round trip.\n"
+           "# TYPE limn_job_store_up gauge\n"
+        << "limn_job_store_up " << (jobs_->healthy() ? 1 : 0) << "\n"
+        << "# HELP limn_job_groups_in_flight Job row groups this replica is computing now.\n"
+           "# TYPE limn_job_groups_in_flight gauge\n"
+        << "limn_job_groups_in_flight " << c.inFlight << "\n"
+        << "# HELP limn_job_groups_total Job row groups this replica finished, by outcome.\n"
+           "# TYPE limn_job_groups_total counter\n"
+        << "limn_job_groups_total{result=\"stored\"} " << c.stored << "\n"
+        << "limn_job_groups_total{result=\"retried\"} " << c.retried << "\n"
+        << "limn_job_groups_total{result=\"released\"} " << c.released << "\n";
+  }
 
   api::Answer answer;
   answer.status = 200;

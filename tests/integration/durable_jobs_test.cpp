@@ -62,9 +62,9 @@ std::string jobSpec(int port, const std::string& mesh, int views, int size) {
 
 // A server on `store` whose leases are short, so that a dead replica's work moves on quickly.
 ServerProcess serverOn(const std::string& store, int workers = 1) {
-  return ServerProcess::withConfig(R"({"workers": )" + std::to_string(workers) +
-                                       R"(, "jobLeaseSeconds": 2})",
-                                   {"--job-store", store});
+  return ServerProcess::withConfig(
+      R"({"workers": )" + std::to_string(workers) + R"(, "jobLeaseSeconds": 2})",
+      {"--job-store", store});
 }
 
 rapidjson::Document jobOf(int port, const std::string& id) {
@@ -225,18 +225,18 @@ TEST(DurableJobs, AnIdempotencyKeyReturnsTheSameJobAndTheListIsPaged) {
 
 TEST(DurableJobs, AStoreThatCannotBeOpenedEndsTheStartNamingIt) {
   const std::string binary = limnBinary();
-  CommandResult unreachable = runCommand(
-      binary + " serve --listen 127.0.0.1:0 --job-store "
-               "'postgresql:///limn?host=/nonexistent-limn-socket&user=postgres' 2>&1");
+  CommandResult unreachable =
+      runCommand(binary +
+                 " serve --listen 127.0.0.1:0 --job-store "
+                 "'postgresql:///limn?host=/nonexistent-limn-socket&user=postgres' 2>&1");
   EXPECT_EQ(unreachable.status, 1) << unreachable.output;
   EXPECT_NE(unreachable.output.find("/nonexistent-limn-socket"), std::string::npos)
       << unreachable.output;
 
   const fs::path notes = tempFolder() / "notes.sqlite";
   std::ofstream(notes) << "not a database, but someone's notes\n";
-  CommandResult corrupt =
-      runCommand(binary + " serve --listen 127.0.0.1:0 --job-store sqlite:" + notes.string() +
-                 " 2>&1");
+  CommandResult corrupt = runCommand(
+      binary + " serve --listen 127.0.0.1:0 --job-store sqlite:" + notes.string() + " 2>&1");
   EXPECT_EQ(corrupt.status, 1) << corrupt.output;
   EXPECT_NE(corrupt.output.find("not a database"), std::string::npos) << corrupt.output;
   std::ifstream in(notes);
@@ -252,8 +252,7 @@ TEST(DurableJobs, AStoreThatCannotBeOpenedEndsTheStartNamingIt) {
 TEST(DurableJobs, AStoreLostWhileServingIs503ForJobsWhileRendersGoOn) {
   PostgresCluster postgres;
   ServerProcess server = serverOn(postgres.createDatabase());
-  HttpResponse created =
-      post(server.port(), "/v1/jobs", jobSpec(server.port(), "cube", 1, 32));
+  HttpResponse created = post(server.port(), "/v1/jobs", jobSpec(server.port(), "cube", 1, 32));
   ASSERT_EQ(created.status, 202);
   const std::string id = parse(created.body)["id"].GetString();
   postgres.stop();
@@ -262,9 +261,11 @@ TEST(DurableJobs, AStoreLostWhileServingIs503ForJobsWhileRendersGoOn) {
   EXPECT_TRUE(lost.has("Retry-After"));
   EXPECT_NE(lost.body.find("job store"), std::string::npos) << lost.body;
   EXPECT_EQ(get(server.port(), "/readyz").status, 503);
-  HttpResponse render = post(server.port(), "/v1/render",
-                             R"({"mesh":{"format":"obj","data":"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},)"
-                             R"("camera":{"width":32,"height":32}})");
+  EXPECT_NE(get(server.port(), "/metrics").body.find("\nlimn_job_store_up 0\n"), std::string::npos);
+  HttpResponse render =
+      post(server.port(), "/v1/render",
+           R"({"mesh":{"format":"obj","data":"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},)"
+           R"("camera":{"width":32,"height":32}})");
   EXPECT_EQ(render.status, 200) << render.body.substr(0, 300);
 
   postgres.start();
@@ -273,6 +274,10 @@ TEST(DurableJobs, AStoreLostWhileServingIs503ForJobsWhileRendersGoOn) {
     std::this_thread::sleep_for(200ms);
   EXPECT_EQ(get(server.port(), "/readyz").status, 200);
   EXPECT_STREQ(waitForEnd(server.port(), id, 120s)["state"].GetString(), "done");
+  const std::string metrics = get(server.port(), "/metrics").body;
+  EXPECT_NE(metrics.find("\nlimn_job_store_up 1\n"), std::string::npos);
+  EXPECT_NE(metrics.find("\nlimn_job_groups_total{result=\"stored\"} 1\n"), std::string::npos)
+      << metrics.substr(metrics.find("limn_job_groups_total"), 300);
   EXPECT_EQ(server.terminate(SIGTERM), 0);
 }
 

@@ -8,7 +8,10 @@
 //      and /readyz, the container port the image listens on, a configuration that limn accepts,
 //      CPU equal to the workers and memory for them, a grace period longer than the drain,
 //      selectors that select, the Indexed Job's --shard-count equal to its completions, the
-//      merge step on the shards' volume, every kustomization complete.
+//      merge step on the shards' volume, every kustomization complete; the job store: the
+//      servers' LIMN_JOB_STORE a PostgreSQL URI from a Secret of their kustomization, naming the
+//      database's Service, port, role, password and database, each pod its own LIMN_REPLICA,
+//      and the database's StatefulSet with its data on a claim, ready only when it answers.
 //
 //   node tests/k8s/validate.mjs --modules NODE_MODULES [--self-test] MANIFEST_DIR
 // Exits 1 and lists every problem when one is found. --self-test instead breaks the manifests
@@ -196,6 +199,8 @@ function unknownKeys(value, reference, prefix = "") {
   return found;
 }
 
+const imageName = (c) => String(c.image ?? "").split(":")[0];
+
 function podSpecOf(obj) {
   return obj?.spec?.template?.spec;
 }
@@ -246,6 +251,7 @@ function checkPod(all, o, errors) {
   if (!pod) return;
   if (pod.securityContext?.runAsNonRoot !== true) errors.push(`${what}: securityContext.runAsNonRoot must be true`);
   const volumes = new Map((pod.volumes ?? []).map((v) => [v.name, v]));
+  for (const t of o.obj.spec?.volumeClaimTemplates ?? []) volumes.set(t.metadata?.name, { persistentVolumeClaim: {} });
   for (const v of pod.volumes ?? []) {
     if (v.configMap && !all.some((x) => x.obj.kind === "ConfigMap" && x.obj.metadata?.name === v.configMap.name))
       errors.push(`${what}: volume ${v.name} names ConfigMap ${v.configMap.name}, which no manifest defines`);
@@ -261,15 +267,19 @@ function checkPod(all, o, errors) {
     if (!(sc.capabilities?.drop ?? []).includes("ALL")) errors.push(`${cw}: securityContext.capabilities.drop must include ALL`);
     for (const m of c.volumeMounts ?? [])
       if (!volumes.has(m.name)) errors.push(`${cw}: volumeMount ${m.name} names no volume of the pod`);
-    // Mesa's shader cache and matplotlib's write under /tmp; the root is read-only.
+    // Mesa's shader cache, matplotlib and PostgreSQL's tools write under /tmp; the root is read-only.
     if (!(c.volumeMounts ?? []).some((m) => m.mountPath === "/tmp"))
       errors.push(`${cw}: nothing is mounted at /tmp (the root filesystem is read-only)`);
     const req = c.resources?.requests ?? {}, lim = c.resources?.limits ?? {};
     for (const r of ["cpu", "memory"])
       if (req[r] === undefined || lim[r] === undefined) errors.push(`${cw}: resources need requests and limits of ${r}`);
     if (bytes(lim.memory) < bytes(req.memory)) errors.push(`${cw}: memory limit below its request`);
-    const image = String(c.image ?? "").split(":")[0];
-    if (!["limn", "limn-report"].includes(image)) errors.push(`${cw}: image ${c.image} is not limn's (limn or limn-report)`);
+    // The one StatefulSet is the job store's database; every other pod runs limn.
+    if (o.obj.kind === "StatefulSet") {
+      if (imageName(c) !== "postgres") errors.push(`${cw}: image ${c.image} is not PostgreSQL's (postgres)`);
+      continue;
+    }
+    if (!["limn", "limn-report"].includes(imageName(c))) errors.push(`${cw}: image ${c.image} is not limn's (limn or limn-report)`);
     if (!["serve", "batch", "render"].includes((c.args ?? [])[0]))
       errors.push(`${cw}: args must start with a limn command (serve, batch, render), not ${JSON.stringify(c.args)}`);
     const lp = envOf(c, "LP_NUM_THREADS");
@@ -389,15 +399,15 @@ function checkService(all, errors) {
   for (const o of all) {
     const { kind, spec = {} } = o.obj;
     if (kind === "Service") {
-      const targets = selects(all, spec.selector);
-      if (!targets.length) errors.push(`${where(o)}: selector ${JSON.stringify(spec.selector)} selects no Deployment's pods`);
+      const targets = selects(all, spec.selector, ["Deployment", "StatefulSet"]);
+      if (!targets.length) errors.push(`${where(o)}: selector ${JSON.stringify(spec.selector)} selects no Deployment's or StatefulSet's pods`);
       for (const p of spec.ports ?? []) {
         const ok = targets.some((d) => (podSpecOf(d.obj)?.containers ?? []).some((c) =>
           (c.ports ?? []).some((cp) => cp.name === p.targetPort || cp.containerPort === p.targetPort)));
         if (targets.length && !ok) errors.push(`${where(o)}: targetPort ${p.targetPort} is no container port of the pods`);
       }
     }
-    if (kind === "Deployment" && !subset(spec.selector?.matchLabels, spec.template?.metadata?.labels))
+    if (["Deployment", "StatefulSet"].includes(kind) && !subset(spec.selector?.matchLabels, spec.template?.metadata?.labels))
       errors.push(`${where(o)}: selector.matchLabels do not match the pod template's labels`);
     if (kind === "HorizontalPodAutoscaler") {
       const t = spec.scaleTargetRef ?? {};
@@ -414,6 +424,160 @@ function checkService(all, errors) {
         if (typeof spec.minAvailable === "number" && spec.minAvailable >= fewest)
           errors.push(`${where(o)}: minAvailable ${spec.minAvailable} leaves no pod of ${fewest} evictable: node drains would block`);
       }
+    }
+  }
+}
+
+// ---- the job store ---------------------------------------------------------------------------
+
+// POST /v1/jobs keeps its jobs in one store that every replica of limn serve shares: a
+// PostgreSQL database (limn creates its tables itself), here a StatefulSet unless the URI names
+// a managed one. Each replica names itself in the rows and leases it takes (LIMN_REPLICA).
+const postgresPort = 5432; // the postgres image's
+const postgresData = "/var/lib/postgresql/data"; // the postgres image's PGDATA
+
+const within = (file, dir) => {
+  const d = path.posix.normalize(dir).replace(/\/$/, "");
+  const f = path.posix.normalize(file).replace(/\/$/, "");
+  return f === d || f.startsWith(d + "/");
+};
+
+// The kustomization whose resources list a manifest's file.
+function kustomizationOf(tree, file) {
+  return tree.kustomizations.find((k) => (k.obj.resources ?? []).some((r) =>
+    path.posix.normalize(path.posix.join(path.posix.dirname(k.file), r)) === file));
+}
+
+// The value a secretKeyRef of `o`'s pods reads: the Secret must be a manifest that the same
+// kustomization applies, with that key. Undefined, and what is wrong in errors, otherwise.
+function secretRef(tree, o, ref, what, errors) {
+  const secret = tree.objects.find((x) => x.obj.kind === "Secret" && x.obj.metadata?.name === ref.name);
+  if (!secret) {
+    errors.push(`${what} names Secret ${ref.name}, which no manifest defines`);
+    return undefined;
+  }
+  const mine = kustomizationOf(tree, o.file);
+  if (mine && kustomizationOf(tree, secret.file) !== mine)
+    errors.push(`${what}: Secret ${ref.name} (${secret.file}) is not applied by ${mine.file}, which applies ${where(o)}`);
+  const { stringData = {}, data = {} } = secret.obj;
+  if (stringData[ref.key] !== undefined) return String(stringData[ref.key]);
+  if (data[ref.key] !== undefined) return Buffer.from(String(data[ref.key]), "base64").toString("utf8");
+  errors.push(`${what}: Secret ${ref.name} has no key ${ref.key}`);
+  return undefined;
+}
+
+const postgresContainers = (o) => (podSpecOf(o.obj)?.containers ?? []).filter((c) => imageName(c) === "postgres");
+
+// Where LIMN_JOB_STORE leads: a URI limn takes, at the database's Service and port, with its
+// role, password and database.
+function checkStoreUri(tree, cw, uri, errors) {
+  const all = tree.objects;
+  if (uri.startsWith("sqlite:")) {
+    errors.push(`${cw}: LIMN_JOB_STORE is a SQLite file (${uri}): each pod would keep its own, and replicas would not share jobs`);
+    return;
+  }
+  let url;
+  try {
+    url = new URL(uri);
+  } catch {
+    url = null;
+  }
+  if (!url || !["postgresql:", "postgres:"].includes(url.protocol)) {
+    errors.push(`${cw}: LIMN_JOB_STORE is not a postgresql:// URI (limn takes sqlite:PATH or a libpq URI)`);
+    return;
+  }
+  const databases = all.filter((x) => x.obj.kind === "StatefulSet" && postgresContainers(x).length);
+  const host = decodeURIComponent(url.hostname);
+  // A Service of these manifests: its bare name, or name.namespace.svc[.cluster.local].
+  const service = (!host.includes(".") || /\.svc(\.|$)/.test(host)) &&
+    all.find((x) => x.obj.kind === "Service" && x.obj.metadata?.name === host.split(".")[0]);
+  if (!service) {
+    // Elsewhere: a managed database, which no manifest here can vouch for; but then no
+    // StatefulSet of PostgreSQL should be running beside it unused.
+    if (databases.length)
+      errors.push(`${cw}: LIMN_JOB_STORE points at ${host}, not at the Service of the job store's StatefulSet (${databases.map((d) => d.obj.spec?.serviceName).join(", ")})`);
+    return;
+  }
+  const name = service.obj.metadata.name;
+  const port = Number(url.port || postgresPort);
+  if (!(service.obj.spec?.ports ?? []).some((p) => p.port === port))
+    errors.push(`${cw}: LIMN_JOB_STORE's port ${port} is not a port of Service ${name}`);
+  const db = databases.find((d) => subset(service.obj.spec?.selector, d.obj.spec?.template?.metadata?.labels));
+  if (!db) {
+    errors.push(`${cw}: LIMN_JOB_STORE's Service ${name} selects no PostgreSQL StatefulSet's pods`);
+    return;
+  }
+  const pc = postgresContainers(db)[0];
+  const role = decodeURIComponent(url.username);
+  const wantRole = envOf(pc, "POSTGRES_USER")?.value ?? "postgres";
+  if (role !== wantRole) errors.push(`${cw}: LIMN_JOB_STORE's role ${role || "(none)"} is not the database's POSTGRES_USER ${wantRole}`);
+  // libpq's database is the role's name when the URI names none.
+  const database = decodeURIComponent(url.pathname.replace(/^\//, "")) || role;
+  const wantDatabase = envOf(pc, "POSTGRES_DB")?.value ?? wantRole;
+  if (database !== wantDatabase) errors.push(`${cw}: LIMN_JOB_STORE's database ${database} is not the database's POSTGRES_DB ${wantDatabase}`);
+  const pw = envOf(pc, "POSTGRES_PASSWORD");
+  const password = pw?.valueFrom?.secretKeyRef ? secretRef(tree, db, pw.valueFrom.secretKeyRef, `${where(db)} container ${pc.name}: POSTGRES_PASSWORD`, []) : pw?.value;
+  if (password !== undefined && decodeURIComponent(url.password) !== password)
+    errors.push(`${cw}: LIMN_JOB_STORE's password is not the database's POSTGRES_PASSWORD`);
+}
+
+function checkJobStore(tree, errors) {
+  const all = tree.objects;
+  for (const o of all.filter((x) => x.obj.kind === "Deployment")) {
+    for (const c of (podSpecOf(o.obj)?.containers ?? []).filter((c) => c.args?.[0] === "serve")) {
+      const cw = `${where(o)} container ${c.name}`;
+      const store = envOf(c, "LIMN_JOB_STORE");
+      const ref = store?.valueFrom?.secretKeyRef;
+      if (!store) {
+        errors.push(`${cw}: no LIMN_JOB_STORE: each pod would keep a SQLite file of its own (on a read-only root), and replicas would not share jobs`);
+      } else if (!ref) {
+        errors.push(`${cw}: LIMN_JOB_STORE must come from a Secret (secretKeyRef): the URI holds the database's password`);
+      } else {
+        if (ref.optional) errors.push(`${cw}: LIMN_JOB_STORE's secretKeyRef must not be optional: without the Secret, each pod would keep a SQLite file of its own`);
+        const uri = secretRef(tree, o, ref, `${cw}: LIMN_JOB_STORE`, errors);
+        if (uri !== undefined) checkStoreUri(tree, cw, uri, errors);
+      }
+      const replica = envOf(c, "LIMN_REPLICA");
+      if (replica?.valueFrom?.fieldRef?.fieldPath !== "metadata.name")
+        errors.push(`${cw}: LIMN_REPLICA must be the pod's name (fieldRef metadata.name), not ${JSON.stringify(replica?.value ?? replica?.valueFrom ?? null)}: it names the replica in the rows and leases it takes, and pods sharing one would renew each other's leases`);
+    }
+  }
+  for (const o of all.filter((x) => x.obj.kind === "StatefulSet")) {
+    const what = where(o);
+    const spec = o.obj.spec ?? {};
+    const pod = podSpecOf(o.obj);
+    if ((spec.replicas ?? 1) !== 1)
+      errors.push(`${what}: replicas ${spec.replicas}: PostgreSQL here is one primary; more pods would be separate databases, each on a volume of its own`);
+    const service = all.find((x) => x.obj.kind === "Service" && x.obj.metadata?.name === spec.serviceName);
+    if (!service) errors.push(`${what}: serviceName ${spec.serviceName} names no Service of the manifests`);
+    else {
+      if (service.obj.spec?.clusterIP !== "None")
+        errors.push(`${where(service)}: must be headless (clusterIP: None), as the serviceName of ${what}`);
+      if (!subset(service.obj.spec?.selector, spec.template?.metadata?.labels))
+        errors.push(`${where(service)}: selector does not select the pods of ${what}, whose serviceName it is`);
+    }
+    const sc = pod?.securityContext ?? {};
+    if (sc.fsGroup === undefined)
+      errors.push(`${what}: securityContext.fsGroup must be set: the claim is root's otherwise, and PostgreSQL runs as user ${sc.runAsUser}`);
+    if (sc.fsGroupChangePolicy !== "OnRootMismatch")
+      errors.push(`${what}: securityContext.fsGroupChangePolicy must be OnRootMismatch: a recursive change at every start makes PGDATA group-writable, and PostgreSQL then refuses to start`);
+    const claims = new Set((spec.volumeClaimTemplates ?? []).map((t) => t.metadata?.name));
+    for (const c of postgresContainers(o)) {
+      const cw = `${what} container ${c.name}`;
+      const data = envOf(c, "PGDATA")?.value ?? postgresData;
+      const mount = (c.volumeMounts ?? []).filter((m) => within(data, m.mountPath))
+        .sort((a, b) => b.mountPath.length - a.mountPath.length)[0];
+      if (!mount || !claims.has(mount.name))
+        errors.push(`${cw}: PGDATA ${data} is not on a volumeClaimTemplate (${mount ? `but on volume ${mount.name}` : "but in the container"}): the jobs would go with the pod`);
+      else if (within(mount.mountPath, data))
+        errors.push(`${cw}: PGDATA ${data} must be a directory below the volume's root ${mount.mountPath}: initdb wants an empty directory, and a new volume may hold lost+found`);
+      if (!(c.readinessProbe?.exec?.command ?? []).join(" ").includes("pg_isready"))
+        errors.push(`${cw}: no readinessProbe running pg_isready: the Service would send limn to a database still starting`);
+      if (!(c.ports ?? []).some((p) => p.containerPort === postgresPort))
+        errors.push(`${cw}: no containerPort ${postgresPort}, where PostgreSQL listens`);
+      const pw = envOf(c, "POSTGRES_PASSWORD");
+      if (!pw?.valueFrom?.secretKeyRef) errors.push(`${cw}: POSTGRES_PASSWORD must come from a Secret (secretKeyRef)`);
+      else secretRef(tree, o, pw.valueFrom.secretKeyRef, `${cw}: POSTGRES_PASSWORD`, errors);
     }
   }
 }
@@ -461,6 +625,7 @@ function contractErrors(tree) {
   }
   checkService(all, errors);
   checkBatch(all, errors);
+  checkJobStore(tree, errors);
   checkKustomizations(tree, errors);
   return errors;
 }
@@ -483,6 +648,15 @@ const find = (tree, kind, name) => tree.objects.find((o) => o.obj.kind === kind 
 const top = (t) => t.kustomizations.find((k) => k.file === "kustomization.yaml");
 const server = (t) => podSpecOf(find(t, "Deployment")).containers[0];
 const shardJob = (t) => find(t, "Job", "limn-batch");
+const storeSecret = (t) => find(t, "Secret", "limn-job-store");
+const database = (t) => find(t, "StatefulSet", "limn-postgres");
+const databaseContainer = (t) => podSpecOf(database(t)).containers[0];
+const setStoreUri = (t, f) => {
+  const data = storeSecret(t).stringData;
+  const url = new URL(data.LIMN_JOB_STORE);
+  f(url);
+  data.LIMN_JOB_STORE = url.toString();
+};
 const setConfig = (t, f) => {
   const cm = find(t, "ConfigMap", "limn-config");
   const c = JSON.parse(cm.data["limn.json"]);
@@ -507,7 +681,7 @@ const breakages = [
   ["a grace period shorter than the drain", "terminationGracePeriodSeconds 10", (t) => { podSpecOf(find(t, "Deployment")).terminationGracePeriodSeconds = 10; }],
   ["a writable root filesystem", "readOnlyRootFilesystem must be true", (t) => { server(t).securityContext.readOnlyRootFilesystem = false; }],
   ["running as root allowed", "runAsNonRoot must be true", (t) => { delete podSpecOf(find(t, "Deployment")).securityContext.runAsNonRoot; }],
-  ["a Service that selects nothing", "selects no Deployment", (t) => { find(t, "Service").spec.selector["app.kubernetes.io/component"] = "sever"; }],
+  ["a Service that selects nothing", "selects no Deployment", (t) => { find(t, "Service", "limn").spec.selector["app.kubernetes.io/component"] = "sever"; }],
   ["an HPA aimed at nothing", "scaleTargetRef Deployment/lim ", (t) => { find(t, "HorizontalPodAutoscaler").spec.scaleTargetRef.name = "lim"; }],
   ["a PDB that blocks drains", "leaves no pod of 2 evictable", (t) => { find(t, "PodDisruptionBudget").spec.minAvailable = 2; }],
   ["shards that do not cover the Job", "--shard-count 3 must equal completions 4", (t) => { const c = podSpecOf(shardJob(t)).containers[0]; c.args[c.args.indexOf("--shard-count") + 1] = "3"; }],
@@ -523,6 +697,43 @@ const breakages = [
   ["a manifest no kustomization lists", "listed in no kustomization.yaml", (t) => { top(t).obj.resources.pop(); }],
   ["a kustomization naming a missing file", "resource hpa.yml is not a manifest", (t) => { top(t).obj.resources.push("hpa.yml"); }],
   ["an image override that matches nothing", "images entry limm matches no container", (t) => { top(t).obj.images[0].name = "limm"; }],
+  // The job store.
+  ["no job store: a SQLite file per pod", "no LIMN_JOB_STORE", (t) => { server(t).env = server(t).env.filter((e) => e.name !== "LIMN_JOB_STORE"); }],
+  ["a job store URI in the pod spec", "LIMN_JOB_STORE must come from a Secret", (t) => {
+    const e = envOf(server(t), "LIMN_JOB_STORE");
+    delete e.valueFrom;
+    e.value = storeSecret(t).stringData.LIMN_JOB_STORE;
+  }],
+  ["an optional job store", "secretKeyRef must not be optional", (t) => { envOf(server(t), "LIMN_JOB_STORE").valueFrom.secretKeyRef.optional = true; }],
+  ["a job store from a Secret no manifest defines", "names Secret limn-job-stor,", (t) => { envOf(server(t), "LIMN_JOB_STORE").valueFrom.secretKeyRef.name = "limn-job-stor"; }],
+  ["a job store key the Secret lacks", "has no key JOB_STORE", (t) => { envOf(server(t), "LIMN_JOB_STORE").valueFrom.secretKeyRef.key = "JOB_STORE"; }],
+  ["a job store Secret its kustomization does not apply", "is not applied by kustomization.yaml", (t) => { top(t).obj.resources = top(t).obj.resources.filter((r) => r !== "job-store-secret.yaml"); }],
+  ["a SQLite job store for several replicas", "LIMN_JOB_STORE is a SQLite file", (t) => { storeSecret(t).stringData.LIMN_JOB_STORE = "sqlite:/var/lib/limn/data/jobs.sqlite"; }],
+  ["a job store URI limn refuses", "is not a postgresql:// URI", (t) => { storeSecret(t).stringData.LIMN_JOB_STORE = "mysql://limn@limn-postgres/limn"; }],
+  ["a job store at another host", "points at limn-postgress, not at the Service", (t) => setStoreUri(t, (u) => { u.hostname = "limn-postgress"; })],
+  ["a job store on another port", "port 5433 is not a port of Service limn-postgres", (t) => setStoreUri(t, (u) => { u.port = "5433"; })],
+  ["a job store with another password", "password is not the database's POSTGRES_PASSWORD", (t) => setStoreUri(t, (u) => { u.password = "another"; })],
+  ["a job store with another role", "role limm is not the database's POSTGRES_USER", (t) => setStoreUri(t, (u) => { u.username = "limm"; })],
+  ["a job store in another database", "database limm is not the database's POSTGRES_DB", (t) => setStoreUri(t, (u) => { u.pathname = "/limm"; })],
+  ["replicas sharing one name", "LIMN_REPLICA must be the pod's name", (t) => {
+    const e = envOf(server(t), "LIMN_REPLICA");
+    delete e.valueFrom;
+    e.value = "limn";
+  }],
+  ["two database pods", "replicas 2: PostgreSQL here is one primary", (t) => { database(t).spec.replicas = 2; }],
+  ["a database without its claim", "is not on a volumeClaimTemplate", (t) => { database(t).spec.volumeClaimTemplates[0].metadata.name = "pgdata"; }],
+  ["PGDATA at the volume's root", "must be a directory below the volume's root", (t) => { envOf(databaseContainer(t), "PGDATA").value = "/var/lib/postgresql/data"; }],
+  ["a database ready before it answers", "no readinessProbe running pg_isready", (t) => { delete databaseContainer(t).readinessProbe; }],
+  ["a database Service that selects nothing", "(Service limn-postgres): selector", (t) => { find(t, "Service", "limn-postgres").spec.selector["app.kubernetes.io/component"] = "job-stor"; }],
+  ["a database Service with a cluster IP", "must be headless", (t) => { delete find(t, "Service", "limn-postgres").spec.clusterIP; }],
+  ["a StatefulSet naming no Service", "serviceName limn-postgre names no Service", (t) => { database(t).spec.serviceName = "limn-postgre"; }],
+  ["PGDATA made group-writable at every start", "fsGroupChangePolicy must be OnRootMismatch", (t) => { podSpecOf(database(t)).securityContext.fsGroupChangePolicy = "Always"; }],
+  ["a database password in the pod spec", "POSTGRES_PASSWORD must come from a Secret", (t) => {
+    const e = envOf(databaseContainer(t), "POSTGRES_PASSWORD");
+    delete e.valueFrom;
+    e.value = "secret";
+  }],
+  ["a database image that is not PostgreSQL", "is not PostgreSQL's (postgres)", (t) => { databaseContainer(t).image = "limn:0.1.0"; }],
 ];
 
 async function runSelfTest(tree) {

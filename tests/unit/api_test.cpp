@@ -1096,6 +1096,9 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_TRUE(file.authToken.empty());
   EXPECT_TRUE(file.corsOrigins.empty());
   EXPECT_EQ(file.logLevel, builtIn.logLevel);
+  EXPECT_EQ(file.jobRetentionSeconds, builtIn.jobRetentionSeconds);
+  EXPECT_TRUE(file.jobStore.empty());  // the SQLite file in the data folder
+  EXPECT_EQ(file.jobLeaseSeconds, builtIn.jobLeaseSeconds);
 }
 
 TEST(Config, AuthTokenAndCorsOrigins) {
