@@ -44,7 +44,9 @@ const char* const kSchemaV1[] = {
     " state TEXT NOT NULL, lease_owner TEXT NOT NULL, lease_until_ms BIGINT NOT NULL,"
     " attempts BIGINT NOT NULL, available_ms BIGINT NOT NULL,"
     " PRIMARY KEY (job_id, group_index))",
-    "CREATE INDEX limn_job_groups_free ON limn_job_groups (state, available_ms)",
+    // The groups still to do, in order: a claim reads only these, however many are done.
+    "CREATE INDEX limn_job_groups_open ON limn_job_groups (job_id, group_index)"
+    " WHERE state <> 'done'",
     "CREATE TABLE limn_job_rows ("
     " job_id TEXT NOT NULL, row_index BIGINT NOT NULL, row_key TEXT NOT NULL,"
     " replica TEXT NOT NULL, failed BIGINT NOT NULL, line TEXT NOT NULL,"
@@ -332,40 +334,45 @@ std::optional<ClaimedGroup> JobStore::claim() {
   return locked([&](SqlDatabase& db) {
     return inTransaction(db, [&]() -> std::optional<ClaimedGroup> {
       const int64_t now = nowMs();
-      // Free: pending and due, or leased by a replica that stopped renewing. The oldest job
-      // first, its groups in order.
-      const std::string freeGroup =
-          "SELECT g.job_id, g.group_index FROM limn_job_groups g"
-          " JOIN limn_jobs j ON j.id = g.job_id"
-          " WHERE j.state IN ('queued', 'running') AND ((g.state = 'pending' AND "
-          "g.available_ms <= ?) OR (g.state = 'leased' AND g.lease_until_ms < ?))"
-          " ORDER BY j.created_ms, j.id, g.group_index LIMIT 1";
-      std::vector<SqlRow> claimed;
-      if (db.dialect() == SqlDialect::Postgres) {
-        // Replicas claiming at once skip each other's locked rows instead of waiting on them.
-        claimed = db.query("WITH next AS (" + freeGroup +
-                               " FOR UPDATE OF g SKIP LOCKED)"
-                               " UPDATE limn_job_groups AS u SET state = 'leased', lease_owner = ?,"
-                               " lease_until_ms = ?, attempts = u.attempts + 1 FROM next"
-                               " WHERE u.job_id = next.job_id AND u.group_index = next.group_index"
-                               " RETURNING u.job_id, u.group_index, u.row_indices, u.attempts",
-                           {now, now, replica_, now + options_.lease.count()});
-      } else {
-        // BEGIN IMMEDIATE holds the file's write lock: one claim at a time.
-        claimed = db.query(
-            "UPDATE limn_job_groups SET state = 'leased', lease_owner = ?, lease_until_ms = ?,"
-            " attempts = attempts + 1 WHERE (job_id, group_index) IN (" +
-                freeGroup +
-                ")"
-                " RETURNING job_id, group_index, row_indices, attempts",
-            {replica_, now + options_.lease.count(), now, now});
+      const bool postgres = db.dialect() == SqlDialect::Postgres;
+      // The oldest unfinished job first (there are at most maxJobs), its groups in order.
+      for (const SqlRow& job :
+           db.query("SELECT id FROM limn_jobs WHERE state IN ('queued', 'running')"
+                    " ORDER BY created_ms, id")) {
+        // Free: pending and due, or leased by a replica that stopped renewing it.
+        const std::string freeGroup =
+            "SELECT job_id, group_index FROM limn_job_groups WHERE job_id = ? AND state <> 'done'"
+            " AND ((state = 'pending' AND available_ms <= ?) OR (state = 'leased' AND "
+            "lease_until_ms < ?)) ORDER BY group_index LIMIT 1";
+        std::vector<SqlRow> claimed;
+        if (postgres) {
+          // Replicas claiming at once skip each other's locked rows instead of waiting on them.
+          claimed =
+              db.query("WITH next AS (" + freeGroup +
+                           " FOR UPDATE SKIP LOCKED)"
+                           " UPDATE limn_job_groups AS u SET state = 'leased', lease_owner = ?,"
+                           " lease_until_ms = ?, attempts = u.attempts + 1 FROM next"
+                           " WHERE u.job_id = next.job_id AND u.group_index = next.group_index"
+                           " RETURNING u.job_id, u.group_index, u.row_indices, u.attempts",
+                       {job[0], now, now, replica_, now + options_.lease.count()});
+        } else {
+          // BEGIN IMMEDIATE holds the file's write lock: one claim at a time.
+          claimed = db.query(
+              "UPDATE limn_job_groups SET state = 'leased', lease_owner = ?, lease_until_ms = ?,"
+              " attempts = attempts + 1 WHERE (job_id, group_index) IN (" +
+                  freeGroup +
+                  ")"
+                  " RETURNING job_id, group_index, row_indices, attempts",
+              {replica_, now + options_.lease.count(), job[0], now, now});
+        }
+        if (claimed.empty()) continue;
+        ClaimedGroup group{claimed[0][0], static_cast<size_t>(toInt(claimed[0][1])),
+                           splitIndices(claimed[0][2]), static_cast<int>(toInt(claimed[0][3]))};
+        db.query("UPDATE limn_jobs SET state = 'running' WHERE id = ? AND state = 'queued'",
+                 {group.jobId});
+        return group;
       }
-      if (claimed.empty()) return std::nullopt;
-      ClaimedGroup group{claimed[0][0], static_cast<size_t>(toInt(claimed[0][1])),
-                         splitIndices(claimed[0][2]), static_cast<int>(toInt(claimed[0][3]))};
-      db.query("UPDATE limn_jobs SET state = 'running' WHERE id = ? AND state = 'queued'",
-               {group.jobId});
-      return group;
+      return std::nullopt;
     });
   });
 }

@@ -69,10 +69,13 @@ Timing measure(const std::string& location, size_t rows, size_t groupSize) {
 int main(int argc, char** argv) {
   const size_t rows = argc > 1 ? std::stoul(argv[1]) : 1000;
   namespace fs = std::filesystem;
-  const fs::path folder = fs::temp_directory_path() / ("limn-store-bench-" + std::to_string(::getpid()));
+  const fs::path folder =
+      fs::temp_directory_path() / ("limn-store-bench-" + std::to_string(::getpid()));
   fs::create_directories(folder);
   limn::testing::PostgresCluster postgres;
-  std::printf("| store | rows per group | create job (ms) | claim a group (ms) | store a group (ms) | store time per row (µs) |\n");
+  std::printf(
+      "| store | rows per group | create job (ms) | claim a group (ms) | store a group (ms) | "
+      "store time per row (µs) |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
   int n = 0;
   for (size_t groupSize : {1, 2, 8, 32}) {

@@ -3,7 +3,9 @@
 
   1. one 1,000-row job (the cube from 500 random views x coarse and uniform:1 at 32 px: small
      images, so that the store's share shows) on one `limn serve` with 2 workers on SQLite,
-     the same on PostgreSQL, and on three processes (1 worker each) sharing PostgreSQL;
+     the same on PostgreSQL, and on three processes (1 worker each) sharing PostgreSQL; the
+     same rows through `limn batch --server` (no store) as the baseline; the
+     same rows through `limn batch --server` (no store) as the baseline;
   2. resume: a process on SQLite SIGKILLed at 30% of that job and started again on the same
      file: the restart until it answers, until its first new row, until the job is done.
 
@@ -113,10 +115,28 @@ def run_job(servers, body):
     return seconds, state, replicas
 
 
+def batch_baseline(body, work):
+    """The same rows without a store: `limn batch --server` sends the same /v1/compare bodies."""
+    server = Server("sqlite::memory:", 2, 30, work)
+    with open(os.path.join(work, "spec.json"), "w") as f:
+        f.write(body)
+    out = os.path.join(work, "batch-out")
+    start = time.monotonic()
+    subprocess.run([LIMN, "batch", os.path.join(work, "spec.json"), "--server",
+                    f"http://127.0.0.1:{server.port}", "--out", out], check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    seconds = time.monotonic() - start
+    server.stop()
+    return seconds
+
+
 def throughput(rows, lease, work, postgres):
     body = spec(rows)
+    baseline = batch_baseline(body, work)
     print(f"| setup | workers in all | job time (s) | rows/s | rows per replica |")
     print("|---|---:|---:|---:|---|")
+    print(f"| no store: limn batch --server, 1 process | 2 | {baseline:.1f} | {rows / baseline:.0f} | |",
+          flush=True)
     cases = [("1 process, SQLite", lambda: ["sqlite:" + os.path.join(work, "one.sqlite")], 2),
              ("1 process, PostgreSQL", lambda: [postgres.database()], 2),
              ("3 processes, one PostgreSQL", lambda: [postgres.database()] * 3, 1)]
