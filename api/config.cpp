@@ -150,6 +150,10 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.integer("port", config.port, 0, 65535);
   r.integer("workers", config.workers, 0, 1024);
   r.integer("queueDepth", config.queueDepth, 1);
+  r.integer("reservedInteractiveWorkers", config.reservedInteractiveWorkers, 0, 1024);
+  r.integer("heavyRequestMs", config.heavyRequestMs, 1);
+  r.integer("heavyQueueMs", config.heavyQueueMs, 1);
+  r.integer("clientQueueDepth", config.clientQueueDepth, 0);
   r.integer("ioThreads", config.ioThreads, 1, 256);
   r.size("maxBodyBytes", config.maxBodyBytes, 1);
   r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);

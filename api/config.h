@@ -19,7 +19,15 @@ struct ServiceConfig {
   int port = 8080;      // 0: any free port (tests)
   int workers = 0;      // render workers; 0 = one per core
   int queueDepth = 16;  // jobs waiting for a worker before answering 429
-  int ioThreads = 1;    // threads running the HTTP connections
+  // Lanes (server/worker_pool.h): workers kept for interactive requests (heavy and batch work
+  // takes the others), the estimated run time from which a request is heavy, the estimated heavy
+  // work that may wait before heavy requests get 429, and the requests one client may have
+  // waiting (0: half of queueDepth).
+  int reservedInteractiveWorkers = 1;
+  int heavyRequestMs = 250;
+  int heavyQueueMs = 30000;
+  int clientQueueDepth = 0;
+  int ioThreads = 1;  // threads running the HTTP connections
   // "process": each render worker is a child process (a crash costs one request); "thread":
   // threads of the server itself (for debugging).
   std::string workerIsolation = "process";

@@ -32,13 +32,14 @@ std::vector<size_t> splitIndices(const std::string& text) {
 // Version 1: jobs, their groups (the unit of a lease) and their rows.
 const char* const kSchemaV1[] = {
     "CREATE TABLE limn_jobs ("
-    " id TEXT PRIMARY KEY, client TEXT NOT NULL, idempotency_key TEXT NOT NULL,"
+    " id TEXT PRIMARY KEY, seq BIGINT NOT NULL, client TEXT NOT NULL,"
+    " idempotency_key TEXT NOT NULL,"
     " request_hash TEXT NOT NULL, spec TEXT NOT NULL, state TEXT NOT NULL,"
     " total_rows BIGINT NOT NULL, error TEXT NOT NULL, created_ms BIGINT NOT NULL,"
     " finished_ms BIGINT NOT NULL)",
     "CREATE UNIQUE INDEX limn_jobs_idempotency ON limn_jobs (client, idempotency_key)"
     " WHERE idempotency_key <> ''",
-    "CREATE INDEX limn_jobs_by_client ON limn_jobs (client, created_ms)",
+    "CREATE INDEX limn_jobs_by_client ON limn_jobs (client, seq)",
     "CREATE TABLE limn_job_groups ("
     " job_id TEXT NOT NULL, group_index BIGINT NOT NULL, row_indices TEXT NOT NULL,"
     " state TEXT NOT NULL, lease_owner TEXT NOT NULL, lease_until_ms BIGINT NOT NULL,"
@@ -55,7 +56,7 @@ const char* const kSchemaV1[] = {
 
 // What a job's record is read from (the row counts come from its rows).
 const char* const kJobColumns =
-    "SELECT j.id, j.client, j.state, j.error, j.total_rows, j.created_ms, j.finished_ms,"
+    "SELECT j.id, j.client, j.state, j.error, j.total_rows, j.created_ms, j.finished_ms, j.seq,"
     " (SELECT COUNT(*) FROM limn_job_rows r WHERE r.job_id = j.id),"
     " (SELECT COALESCE(SUM(r.failed), 0) FROM limn_job_rows r WHERE r.job_id = j.id)"
     " FROM limn_jobs j ";
@@ -69,8 +70,9 @@ JobRecord readRecord(const SqlRow& row) {
   job.totalRows = static_cast<size_t>(toInt(row[4]));
   job.createdMs = toInt(row[5]);
   job.finishedMs = toInt(row[6]);
-  job.rowsDone = static_cast<size_t>(toInt(row[7]));
-  job.rowsFailed = static_cast<size_t>(toInt(row[8]));
+  job.sequence = toInt(row[7]);
+  job.rowsDone = static_cast<size_t>(toInt(row[8]));
+  job.rowsFailed = static_cast<size_t>(toInt(row[9]));
   return job;
 }
 
@@ -208,11 +210,14 @@ CreateOutcome JobStore::create(const NewJob& job, size_t maxJobs,
         deleteJobsLocked("id = ?", {oldest[0][0]});
       }
       const std::string id = newJobId();
+      // Creations are serialised (above): the next number is the creation order, which
+      // milliseconds alone are not.
+      const int64_t seq = toInt(db.query("SELECT COALESCE(MAX(seq), 0) + 1 FROM limn_jobs")[0][0]);
       db.query(
-          "INSERT INTO limn_jobs (id, client, idempotency_key, request_hash, spec, state,"
-          " total_rows, error, created_ms, finished_ms) VALUES (?, ?, ?, ?, ?, 'queued', ?, '', ?, "
-          "0)",
-          {id, job.client, job.idempotencyKey, job.requestHash, job.spec,
+          "INSERT INTO limn_jobs (id, seq, client, idempotency_key, request_hash, spec, state,"
+          " total_rows, error, created_ms, finished_ms) VALUES (?, ?, ?, ?, ?, ?, 'queued', ?, '',"
+          " ?, 0)",
+          {id, seq, job.client, job.idempotencyKey, job.requestHash, job.spec,
            static_cast<int64_t>(job.totalRows), now});
       std::vector<std::vector<SqlParam>> groups;
       for (size_t g = 0; g < job.groups.size(); ++g) {
@@ -259,28 +264,23 @@ std::vector<StoredRow> JobStore::rows(const std::string& id, size_t offset, size
 }
 
 JobPage JobStore::list(const std::string& client, const std::string& after, size_t limit) {
-  // The cursor is the last job of the page before: "<created_ms>.<id>".
-  int64_t beforeMs = INT64_MAX;
-  std::string beforeId;
-  if (const size_t dot = after.find('.'); dot != std::string::npos) {
-    try {
-      beforeMs = std::stoll(after.substr(0, dot));
-      beforeId = after.substr(dot + 1);
-    } catch (const std::exception&) {
-    }
+  // The cursor is the creation number of the last job of the page before.
+  int64_t before = INT64_MAX;
+  if (!after.empty() && after.find_first_not_of("0123456789") == std::string::npos &&
+      after.size() < 19) {
+    before = std::stoll(after);
   }
   return locked([&](SqlDatabase& db) {
     JobPage page;
     for (const SqlRow& row :
          db.query(std::string(kJobColumns) +
-                      "WHERE j.client = ? AND (j.created_ms < ? OR (j.created_ms = ? AND j.id < ?))"
-                      " ORDER BY j.created_ms DESC, j.id DESC LIMIT ?",
-                  {client, beforeMs, beforeMs, beforeId, static_cast<int64_t>(limit + 1)})) {
+                      "WHERE j.client = ? AND j.seq < ? ORDER BY j.seq DESC LIMIT ?",
+                  {client, before, static_cast<int64_t>(limit + 1)})) {
       page.jobs.push_back(readRecord(row));
     }
     if (page.jobs.size() > limit) {
       page.jobs.pop_back();
-      page.next = std::to_string(page.jobs.back().createdMs) + "." + page.jobs.back().id;
+      page.next = std::to_string(page.jobs.back().sequence);
     }
     return page;
   });
@@ -338,7 +338,7 @@ std::optional<ClaimedGroup> JobStore::claim() {
       // The oldest unfinished job first (there are at most maxJobs), its groups in order.
       for (const SqlRow& job :
            db.query("SELECT id FROM limn_jobs WHERE state IN ('queued', 'running')"
-                    " ORDER BY created_ms, id")) {
+                    " ORDER BY seq")) {
         // Free: pending and due, or leased by a replica that stopped renewing it.
         const std::string freeGroup =
             "SELECT job_id, group_index FROM limn_job_groups WHERE job_id = ? AND state <> 'done'"
@@ -417,20 +417,43 @@ void JobStore::release(const ClaimedGroup& group, std::chrono::milliseconds dela
   });
 }
 
-std::vector<std::string> JobStore::heartbeat() {
+std::vector<std::string> JobStore::heartbeat(
+    const std::vector<std::pair<std::string, size_t>>& held) {
   return locked([&](SqlDatabase& db) {
-    db.query(
-        "UPDATE limn_job_groups SET lease_until_ms = ? WHERE lease_owner = ? AND state = 'leased'",
-        {nowMs() + options_.lease.count(), replica_});
-    std::vector<std::string> stopped;
-    for (const SqlRow& row :
-         db.query("SELECT DISTINCT g.job_id FROM limn_job_groups g LEFT JOIN limn_jobs j"
-                  " ON j.id = g.job_id WHERE g.lease_owner = ? AND g.state = 'leased'"
-                  " AND (j.id IS NULL OR j.state NOT IN ('queued', 'running'))",
-                  {replica_})) {
-      stopped.push_back(row[0]);
-    }
-    return stopped;
+    return inTransaction(db, [&] {
+      const int64_t until = nowMs() + options_.lease.count();
+      for (const auto& [job, group] : held) {
+        db.query(
+            "UPDATE limn_job_groups SET lease_until_ms = ? WHERE job_id = ? AND group_index = ?"
+            " AND lease_owner = ? AND state = 'leased'",
+            {until, job, static_cast<int64_t>(group), replica_});
+      }
+      std::string notHeld;
+      std::vector<SqlParam> params{replica_};
+      for (const auto& [job, group] : held) {
+        // The cast: PostgreSQL reads an untyped parameter in VALUES as text.
+        notHeld += notHeld.empty()
+                       ? " AND (job_id, group_index) NOT IN (VALUES (?, CAST(? AS BIGINT))"
+                       : ", (?, CAST(? AS BIGINT))";
+        params.push_back(job);
+        params.push_back(static_cast<int64_t>(group));
+      }
+      if (!notHeld.empty()) notHeld += ")";
+      db.query(
+          "UPDATE limn_job_groups SET state = 'pending', lease_owner = '', attempts = attempts - 1"
+          " WHERE lease_owner = ? AND state = 'leased'" +
+              notHeld,
+          params);
+      std::vector<std::string> stopped;
+      for (const SqlRow& row :
+           db.query("SELECT DISTINCT g.job_id FROM limn_job_groups g LEFT JOIN limn_jobs j"
+                    " ON j.id = g.job_id WHERE g.lease_owner = ? AND g.state = 'leased'"
+                    " AND (j.id IS NULL OR j.state NOT IN ('queued', 'running'))",
+                    {replica_})) {
+        stopped.push_back(row[0]);
+      }
+      return stopped;
+    });
   });
 }
 

@@ -47,6 +47,7 @@ struct JobRecord {
   std::string id, client, state, error;  // state: queued, running, done, cancelled, failed
   size_t totalRows = 0, rowsDone = 0, rowsFailed = 0;
   int64_t createdMs = 0, finishedMs = 0;  // wall clock; finishedMs 0 while unfinished
+  int64_t sequence = 0;                   // creation order in the store
   bool finished() const { return finishedMs != 0; }
 };
 
@@ -119,9 +120,11 @@ class JobStore {
   // Gives a group back to be claimed after `delay`; `counted` false: this claim does not count
   // as an attempt (a shutdown, not the group's fault).
   void release(const ClaimedGroup& group, std::chrono::milliseconds delay, bool counted);
-  // Renews this replica's leases; the jobs among them that are no longer running (cancelled,
+  // Renews the leases of the groups this replica is computing (`held`: job id and group) and
+  // hands back, uncounted, any other lease it holds (a group whose rows could not be stored
+  // while the store was lost); the jobs among `held` that are no longer running (cancelled,
   // forgotten elsewhere).
-  std::vector<std::string> heartbeat();
+  std::vector<std::string> heartbeat(const std::vector<std::pair<std::string, size_t>>& held);
   // Gives back every lease this replica holds, uncounted (a clean shutdown).
   void releaseAll();
   // A round trip, reconnecting when the connection was lost; throws while it stays lost.

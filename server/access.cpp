@@ -1,6 +1,20 @@
 #include "server/access.h"
 
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
+#include <cstdio>
+
 namespace limn::server {
+
+std::string clientOf(const std::string& authorization, const std::string& peer) {
+  if (authorization.empty()) return "peer:" + peer;
+  char text[17];
+  std::snprintf(
+      text, sizeof text, "%016llx",
+      static_cast<unsigned long long>(XXH3_64bits(authorization.data(), authorization.size())));
+  return std::string("token:") + text;
+}
 
 namespace {
 

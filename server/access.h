@@ -18,6 +18,10 @@
 
 namespace limn::server {
 
+// Who is asking, for fair shares of the queue, GET /v1/jobs and Idempotency-Key: a digest of
+// the Authorization header when the request carries one, else the peer's address.
+std::string clientOf(const std::string& authorization, const std::string& peer);
+
 // Access-Control-Allow-Origin (and Vary: Origin) for an origin Access allowed.
 void addCorsHeaders(std::string_view origin, api::Answer& answer);
 

@@ -63,6 +63,8 @@ api::Answer HttpClient::request(bool post, const std::string& path, const std::s
                                          url_.prefix + path, 11);
     req.set(http::field::host, url_.host);
     req.set(http::field::user_agent, "limn-batch");
+    // RFC 9218: the lowest urgency. limn runs it in its batch lane, after everyone's requests.
+    req.set("Priority", "u=7");
     if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
     if (post) {
       req.set(http::field::content_type, "application/json");

@@ -153,7 +153,8 @@ void Connection::handle() {
                   std::string(message[http::field::origin]),
                   requestId_,
                   std::string(message["Idempotency-Key"]),
-                  peerAddress()};
+                  peerAddress(),
+                  std::string(message["Priority"])};
   // The router may answer from a worker thread: hop back onto this connection's strand.
   const unsigned generation = ++handling_;
   abandon_ = shared_.router.handle(

@@ -65,13 +65,6 @@ bool crashed(const api::Answer& answer) {
 
 }  // namespace
 
-std::string clientOf(const std::string& authorization, const std::string& peer) {
-  if (!authorization.empty()) {
-    return "token:" + hex64(XXH3_64bits(authorization.data(), authorization.size()));
-  }
-  return "peer:" + peer;
-}
-
 JobManager::JobManager(WorkerPool& pool, const render::pipeline::JobLimits& limits,
                        JobOptions options, std::unique_ptr<batch::JobStore> store,
                        render::mesh::MeshCache* meshes)
@@ -333,7 +326,8 @@ void JobManager::runLoop() {
 
 JobManager::Claimed JobManager::claimWork() {
   for (;;) {
-    // Requests first: a group is claimed only for a worker that nothing waits for.
+    // Requests first: a group is claimed only for a worker that batch work may use and that
+    // nothing waits for (the pool's batch lane comes after the others anyway).
     const PoolSnapshot pool = pool_.snapshot();
     if (pool.stopping || pool.draining) return Claimed::Nothing;
     {
@@ -341,9 +335,7 @@ JobManager::Claimed JobManager::claimWork() {
       if (stopping_) return Claimed::Nothing;
       if (static_cast<int>(inFlight_.size()) >= pool.readyWorkers) return Claimed::Full;
     }
-    if (pool.busyWorkers + static_cast<int>(pool.queued) >= pool.readyWorkers) {
-      return Claimed::PoolBusy;
-    }
+    if (pool.freeForBatch <= 0) return Claimed::PoolBusy;
     try {
       std::optional<batch::ClaimedGroup> group = store_->claim();
       if (!group) return Claimed::Nothing;
@@ -472,7 +464,12 @@ void JobManager::heartbeat() {
       wasHealthy = healthy_;
     }
     if (!wasHealthy) store_->ping();
-    std::vector<std::string> stopped = store_->heartbeat();
+    std::vector<std::pair<std::string, size_t>> held;
+    {
+      std::lock_guard lock(mutex_);
+      for (const auto& [key, flight] : inFlight_) held.push_back(key);
+    }
+    std::vector<std::string> stopped = store_->heartbeat(held);
     store_->expire(options_.retention);
     std::vector<WorkerPool::Abandon> abandons;
     {

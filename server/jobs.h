@@ -42,10 +42,6 @@ struct JobOptions {
   std::chrono::milliseconds poll{500};   // an idle runner asks the store for work this often
 };
 
-// Who is asking, for GET /v1/jobs and Idempotency-Key: a digest of the bearer token when the
-// request carries one, else the peer's address.
-std::string clientOf(const std::string& authorization, const std::string& peer);
-
 class JobManager {
  public:
   // `pool`, `meshes` (may be null) must outlive the manager; stop() before the pool stops.

@@ -11,6 +11,7 @@
 
 #include "api/json_util.h"
 #include "api/openapi.h"
+#include "api/work_estimate.h"
 #include "server/web_assets.h"
 
 #ifndef LIMN_VERSION
@@ -200,9 +201,28 @@ api::Answer Router::webAsset(const EmbeddedFile& file) const {
   return answer;
 }
 
+// RFC 9218's urgency: 6 and 7 are background work ("u=7", as limn batch --server sends).
+bool backgroundPriority(std::string_view priority) {
+  const size_t at = priority.find("u=");
+  return at != std::string_view::npos && at + 2 < priority.size() &&
+         (priority[at + 2] == '6' || priority[at + 2] == '7');
+}
+
+JobClass Router::classify(const Route& route, const Request& request) const {
+  JobClass jobClass;
+  jobClass.client = clientOf(request.authorization, request.peer);
+  jobClass.batch = backgroundPriority(request.priority);
+  const api::WorkSize work = api::estimateWork(
+      endpointPath(route.endpoint), request.body,
+      [this](const std::string& id) { return meshes_ ? meshes_->facesOf(id) : -1; });
+  jobClass.referenceSeconds = api::referenceSeconds(work);
+  return jobClass;
+}
+
 WorkerPool::Abandon Router::compute(const Route& route, Request& request, Reply& reply) {
+  JobClass jobClass = classify(route, request);
   return pool_.submit(Task{route.endpoint, std::move(request.body), std::move(request.accept)},
-                      std::move(reply), request.id);
+                      std::move(reply), request.id, std::move(jobClass));
 }
 
 // Parsing a large mesh takes a while: it runs on a worker's thread like a render (same queue,
@@ -218,7 +238,7 @@ WorkerPool::Abandon Router::uploadMesh(const Route&, Request& request, Reply& re
           render::pipeline::RenderContext&, const render::CancelToken&) {
         return api::handleMeshUpload(body, limits, *meshes);
       },
-      std::move(reply));
+      std::move(reply), clientOf(request.authorization, request.peer));
 }
 
 // A job's spec (its meshes) is read on a worker's thread, like an upload; its state and
@@ -363,7 +383,37 @@ WorkerPool::Abandon Router::metricsText(const Route&, Request&, Reply& reply) {
       << "limn_queue_depth " << pool.queued << "\n"
       << "# HELP limn_queue_capacity Render jobs that may wait before requests get 429.\n"
          "# TYPE limn_queue_capacity gauge\n"
-      << "limn_queue_capacity " << pool.queueCapacity << "\n"
+      << "limn_queue_capacity " << pool.queueCapacity << "\n";
+  out << "# HELP limn_lane_queue_depth Jobs waiting for a worker, by lane.\n"
+         "# TYPE limn_lane_queue_depth gauge\n";
+  for (size_t l = 0; l < kLanes; ++l) {
+    out << "limn_lane_queue_depth{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} "
+        << pool.queuedByLane[l] << "\n";
+  }
+  out << "# HELP limn_lane_running Jobs running on a worker, by lane.\n"
+         "# TYPE limn_lane_running gauge\n";
+  for (size_t l = 0; l < kLanes; ++l) {
+    out << "limn_lane_running{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} "
+        << pool.runningByLane[l] << "\n";
+  }
+  out << "# HELP limn_admissions_total Jobs admitted to a lane.\n"
+         "# TYPE limn_admissions_total counter\n";
+  for (size_t l = 0; l < kLanes; ++l) {
+    out << "limn_admissions_total{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} "
+        << pool.admitted[l] << "\n";
+  }
+  out << "# HELP limn_admission_refusals_total Jobs refused 429 at admission, by reason (busy: "
+         "the queue, heavy: the heavy lane's budget, client: the client's share).\n"
+         "# TYPE limn_admission_refusals_total counter\n";
+  for (const char* reason : {"busy", "heavy", "client"}) {
+    auto it = pool.refusals.find(reason);
+    out << "limn_admission_refusals_total{reason=\"" << reason << "\"} "
+        << (it == pool.refusals.end() ? 0 : it->second) << "\n";
+  }
+  out << "# HELP limn_cost_speed_factor This machine's run time over the reference estimate, "
+         "learned from the jobs run so far.\n"
+         "# TYPE limn_cost_speed_factor gauge\n"
+      << "limn_cost_speed_factor " << pool.speedFactor << "\n"
       << "# HELP limn_workers Render workers, by whether they hold a GL context.\n"
          "# TYPE limn_workers gauge\n"
       << "limn_workers{state=\"ready\"} " << pool.readyWorkers << "\n"

@@ -46,6 +46,7 @@ struct Request {
   uint64_t id = 0;                  // the X-Request-Id its answer will carry
   std::string idempotencyKey = {};  // the Idempotency-Key header ("" when absent): POST /v1/jobs
   std::string peer = {};            // the client's address ("" in tests without a socket)
+  std::string priority = {};        // the Priority header (RFC 9218): "u=6" or "u=7" is batch
 };
 
 class Router {
@@ -84,6 +85,9 @@ class Router {
   WorkerPool::Abandon openApi(const Route&, Request&, Reply& reply);
   // The route's Endpoint as a Task for the workers.
   WorkerPool::Abandon compute(const Route& route, Request& request, Reply& reply);
+  // The request's lane and cost for the pool: its client, whether it asked to be background,
+  // and its work estimated from its JSON (api/work_estimate.h).
+  JobClass classify(const Route& route, const Request& request) const;
   WorkerPool::Abandon uploadMesh(const Route&, Request& request, Reply& reply);
   WorkerPool::Abandon createJob(const Route&, Request& request, Reply& reply);
   WorkerPool::Abandon getJob(const Route&, Request& request, Reply& reply);

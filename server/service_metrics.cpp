@@ -14,6 +14,8 @@ const std::vector<double> kSecondsBuckets = {0.001, 0.005, 0.01, 0.025, 0.05, 0.
                                              1,     2.5,   5,    10,    30,   60,  120};
 // Control-mesh faces: the corpus spans 1 to a few thousand; limits allow far more.
 const std::vector<double> kFaceBuckets = {10, 100, 1000, 10000, 100000, 1000000};
+// Measured over estimated run time: within a factor 1.25, 2, 4, 8 either way.
+const std::vector<double> kRatioBuckets = {0.125, 0.25, 0.5, 0.8, 1.25, 2, 4, 8};
 
 // The shortest text that reads back as `value` (bucket bounds like 0.005, not 0.005000000001).
 std::string number(double value) {
@@ -77,7 +79,10 @@ void Histogram::write(std::string& out, const std::string& name, const std::stri
 }
 
 ServiceMetrics::ServiceMetrics()
-    : queueWait_(&kSecondsBuckets), jobRun_(&kSecondsBuckets), meshFaces_(&kFaceBuckets) {}
+    : queueWait_(&kSecondsBuckets),
+      jobRun_(&kSecondsBuckets),
+      meshFaces_(&kFaceBuckets),
+      estimateRatio_(&kRatioBuckets) {}
 
 void ServiceMetrics::answered(const std::string& route, int status, double seconds) {
   std::lock_guard lock(mutex_);
@@ -86,10 +91,16 @@ void ServiceMetrics::answered(const std::string& route, int status, double secon
   durations_.try_emplace(key, &kSecondsBuckets).first->second.observe(seconds);
 }
 
-void ServiceMetrics::jobRan(double queueWaitSeconds, double runSeconds, const api::Answer& answer) {
+void ServiceMetrics::jobRan(const std::string& lane, double queueWaitSeconds, double runSeconds,
+                            const api::Answer& answer, double estimatedSeconds) {
   std::lock_guard lock(mutex_);
   queueWait_.observe(queueWaitSeconds);
   jobRun_.observe(runSeconds);
+  laneWaits_.try_emplace(lane, &kSecondsBuckets).first->second.observe(queueWaitSeconds);
+  laneRuns_.try_emplace(lane, &kSecondsBuckets).first->second.observe(runSeconds);
+  if (estimatedSeconds > 0 && answer.status == 200) {
+    estimateRatio_.observe(runSeconds / estimatedSeconds);
+  }
   if (answer.meshFaces > 0) meshFaces_.observe(static_cast<double>(answer.meshFaces));
   for (const api::StageTime& stage : answer.stages) {
     stages_.try_emplace(stage.name, &kSecondsBuckets).first->second.observe(stage.ms / 1000);
@@ -113,6 +124,18 @@ std::string ServiceMetrics::text() const {
   queueWait_.write(out, "limn_queue_wait_seconds", "");
   header(out, "limn_render_seconds", "histogram", "Time workers spent running a job.");
   jobRun_.write(out, "limn_render_seconds", "");
+  header(out, "limn_lane_queue_wait_seconds", "histogram",
+         "Time jobs waited for a worker, by lane (interactive, heavy, batch).");
+  for (const auto& [lane, histogram] : laneWaits_) {
+    histogram.write(out, "limn_lane_queue_wait_seconds", "lane=\"" + labelValue(lane) + "\"");
+  }
+  header(out, "limn_lane_run_seconds", "histogram", "Time workers spent on jobs, by lane.");
+  for (const auto& [lane, histogram] : laneRuns_) {
+    histogram.write(out, "limn_lane_run_seconds", "lane=\"" + labelValue(lane) + "\"");
+  }
+  header(out, "limn_cost_estimate_ratio", "histogram",
+         "Measured run time over the estimate the job was admitted with (1: exact).");
+  estimateRatio_.write(out, "limn_cost_estimate_ratio", "");
   header(out, "limn_render_stage_seconds", "histogram",
          "Time the engine spent in each stage of a job (surface, approx, raster, reference, ...).");
   for (const auto& [stage, histogram] : stages_) {

@@ -39,9 +39,11 @@ class ServiceMetrics {
   // An answer the HTTP layer wrote. `route` is a known path or "other" (Router::routeLabel),
   // so a scanner probing random URLs cannot grow the label set.
   void answered(const std::string& route, int status, double seconds);
-  // A job a render worker ran: how long it waited in the queue, how long it ran, and what the
-  // api layer reported of its stages and its mesh.
-  void jobRan(double queueWaitSeconds, double runSeconds, const api::Answer& answer);
+  // A job a render worker ran: its lane, how long it waited in the queue, how long it ran, what
+  // the api layer reported of its stages and its mesh, and the run time it was estimated at
+  // (0: none; the ratio is recorded for jobs answered 200).
+  void jobRan(const std::string& lane, double queueWaitSeconds, double runSeconds,
+              const api::Answer& answer, double estimatedSeconds = 0);
 
   // The families above as exposition text (HELP, TYPE, samples).
   std::string text() const;
@@ -50,7 +52,8 @@ class ServiceMetrics {
   mutable std::mutex mutex_;
   std::map<std::pair<std::string, int>, size_t> answers_;
   std::map<std::pair<std::string, int>, Histogram> durations_;
-  Histogram queueWait_, jobRun_, meshFaces_;
+  Histogram queueWait_, jobRun_, meshFaces_, estimateRatio_;
+  std::map<std::string, Histogram> laneWaits_, laneRuns_;
   std::map<std::string, Histogram> stages_;
 };
 

@@ -14,14 +14,15 @@ namespace limn::server {
 using Clock = render::CancelToken::Clock;
 
 struct WorkerPool::Job {
-  Job(Task t, Work w, uint64_t id, Reply r, Clock::time_point due)
+  Job(Task t, Work w, uint64_t id, Reply r, Clock::time_point due, JobClass c)
       : task(std::move(t)),
         work(std::move(w)),
         requestId(id),
         reply(std::move(r)),
         queued(Clock::now()),
         deadline(due),
-        token(due) {}
+        token(due),
+        jobClass(std::move(c)) {}
 
   Task task;
   Work work;  // set: run in the server (submitInServer); else `task` is the engine's
@@ -31,17 +32,106 @@ struct WorkerPool::Job {
   render::CancelToken token;
   bool settled = false;
   Deadlines::iterator deadlineEntry;
+  JobClass jobClass;
+  Lane lane = Lane::Interactive;
+  double estimateS = 0;  // jobClass.referenceSeconds corrected by the pool's speed factor
 };
+
+// One lane's waiting jobs: a FIFO per client; the client served longest ago goes next (a client
+// that just arrived before one that was just served), so that no client's stream of requests
+// delays another's by more than one job per client.
+struct WorkerPool::LaneQueue {
+  std::map<std::string, std::deque<std::shared_ptr<Job>>> byClient;
+  std::map<std::string, uint64_t> lastServed;  // the serving tick of each client seen lately
+  uint64_t tick = 0;
+  size_t size = 0;
+  double seconds = 0;  // their estimated work
+
+  void push(std::shared_ptr<Job> job) {
+    seconds += job->estimateS;
+    byClient[job->jobClass.client].push_back(std::move(job));
+    ++size;
+  }
+  std::shared_ptr<Job> pop() {
+    auto next = byClient.begin();
+    uint64_t nextServed = UINT64_MAX;
+    for (auto it = byClient.begin(); it != byClient.end(); ++it) {
+      auto served = lastServed.find(it->first);
+      const uint64_t at = served == lastServed.end() ? 0 : served->second;
+      if (at < nextServed) {
+        next = it;
+        nextServed = at;
+      }
+    }
+    std::shared_ptr<Job> job = std::move(next->second.front());
+    next->second.pop_front();
+    lastServed[next->first] = ++tick;
+    if (next->second.empty()) byClient.erase(next);
+    // Forget the clients with nothing waiting once there are many (their turn restarts at 0).
+    if (lastServed.size() > 4096) {
+      std::erase_if(lastServed, [&](const auto& entry) { return !byClient.count(entry.first); });
+    }
+    forget(*job);
+    return job;
+  }
+  bool remove(const std::shared_ptr<Job>& job) {
+    auto it = byClient.find(job->jobClass.client);
+    if (it == byClient.end()) return false;
+    auto at = std::find(it->second.begin(), it->second.end(), job);
+    if (at == it->second.end()) return false;
+    it->second.erase(at);
+    if (it->second.empty()) byClient.erase(it);
+    forget(*job);
+    return true;
+  }
+  // When the longest-waiting job came.
+  Clock::time_point oldest() const {
+    Clock::time_point first = Clock::time_point::max();
+    for (const auto& [client, fifo] : byClient) first = std::min(first, fifo.front()->queued);
+    return first;
+  }
+  template <typename Fn>
+  void forEach(Fn&& fn) const {
+    for (const auto& [client, fifo] : byClient) {
+      for (const auto& job : fifo) fn(job);
+    }
+  }
+  void clear() {
+    byClient.clear();
+    size = 0;
+    seconds = 0;
+  }
+
+ private:
+  void forget(const Job& job) {
+    --size;
+    seconds = std::max(0.0, seconds - job.estimateS);
+  }
+};
+
+const char* laneName(Lane lane) {
+  switch (lane) {
+    case Lane::Interactive:
+      return "interactive";
+    case Lane::Heavy:
+      return "heavy";
+    case Lane::Batch:
+      return "batch";
+  }
+  return "interactive";
+}
 
 namespace {
 
-api::Answer busyAnswer(size_t capacity, int retryAfterS) {
+api::Answer busyAnswer(const std::string& message, const std::string& limit, int retryAfterS) {
   api::Answer answer = api::errorAnswer(
-      {429, "busy",
-       "the render queue is full (" + std::to_string(capacity) + " waiting); retry later"});
+      {429, "busy", message,
+       "{\"limit\":\"" + limit + "\",\"retryAfterS\":" + std::to_string(retryAfterS) + "}"});
   answer.headers.emplace_back("Retry-After", std::to_string(retryAfterS));
   return answer;
 }
+
+size_t laneIndex(Lane lane) { return static_cast<size_t>(lane); }
 
 api::Answer timeoutAnswer(std::chrono::milliseconds timeout) {
   return api::errorAnswer({504, "timeout",
@@ -79,6 +169,10 @@ PoolOptions poolOptions(const api::ServiceConfig& config) {
   options.isolation = config.workerIsolation == "thread" ? Isolation::Thread : Isolation::Process;
   options.limits = config.limits;
   options.referenceCacheBytes = config.referenceCacheBytes;
+  options.reservedInteractive = config.reservedInteractiveWorkers;
+  options.heavySeconds = config.heavyRequestMs / 1000.0;
+  options.heavyQueueSeconds = config.heavyQueueMs / 1000.0;
+  options.clientQueueDepth = static_cast<size_t>(config.clientQueueDepth);
   return options;
 }
 
@@ -117,7 +211,9 @@ WorkerPool::WorkerPool(const PoolOptions& options) : options_(options) {
         std::make_unique<render::oracle::ReferenceSceneCache>(options_.referenceCacheBytes);
   }
   status_.resize(count);
+  assigned_.resize(count);
   referenceCounters_.resize(count);
+  for (auto& lane : lanes_) lane = std::make_unique<LaneQueue>();
 
   // Workers report their GL context before taking jobs, so that the first request after the
   // server says "listening" does not pay for context creation and /healthz is right at once.
@@ -184,7 +280,7 @@ WorkerProcessOptions WorkerPool::workerProcessOptions() const {
   options.executable = options_.workerExecutable;
   options.config.limits = options_.limits;
   options.config.referenceCacheBytes =
-      options_.referenceCacheBytes / static_cast<size_t>(options_.workers);
+      options_.referenceCacheBytes / std::max<size_t>(status_.size(), 1);
   options.maxMemoryBytes = options_.limits.maxWorkerMemoryBytes;
   options.abandonStart = &stopRequested_;
   return options;
@@ -216,7 +312,7 @@ std::unique_ptr<WorkerProcess> WorkerPool::startWorkerProcess(size_t slot) {
     status_[slot].ready = false;
     status_[slot].pid = 0;
     status_[slot].error = error;
-    if (started_ < options_.workers && status_[slot].starts == 0) return nullptr;
+    if (started_ < static_cast<int>(status_.size()) && status_[slot].starts == 0) return nullptr;
     if (workAvailable_.wait_for(lock, kRestartBackoff, [this] { return stopping_; })) {
       return nullptr;
     }
@@ -362,14 +458,17 @@ api::Answer WorkerPool::runHere(Job& job, render::pipeline::RenderContext& conte
   }
 }
 
-WorkerPool::Abandon WorkerPool::submit(Task task, Reply reply, uint64_t requestId) {
+WorkerPool::Abandon WorkerPool::submit(Task task, Reply reply, uint64_t requestId,
+                                       JobClass jobClass) {
   return enqueue(std::make_shared<Job>(std::move(task), nullptr, requestId, std::move(reply),
-                                       Clock::now() + options_.timeout));
+                                       Clock::now() + options_.timeout, std::move(jobClass)));
 }
 
-WorkerPool::Abandon WorkerPool::submitInServer(Work work, Reply reply) {
+WorkerPool::Abandon WorkerPool::submitInServer(Work work, Reply reply, std::string client) {
+  JobClass jobClass;
+  jobClass.client = std::move(client);
   return enqueue(std::make_shared<Job>(Task{}, std::move(work), 0, std::move(reply),
-                                       Clock::now() + options_.timeout));
+                                       Clock::now() + options_.timeout, std::move(jobClass)));
 }
 
 WorkerPool::Abandon WorkerPool::enqueue(std::shared_ptr<Job> job) {
@@ -378,17 +477,17 @@ WorkerPool::Abandon WorkerPool::enqueue(std::shared_ptr<Job> job) {
     std::lock_guard lock(mutex_);
     if (stopping_ || draining_) {
       refusal = unavailableAnswer("the server is shutting down");
-    } else if (glFailures_ == options_.workers) {
+    } else if (glFailures_ == static_cast<int>(status_.size())) {
       refusal = unavailableAnswer("no render worker has an OpenGL context: " +
                                   (status_.empty() ? std::string() : status_.front().error));
-    } else if (queue_.size() >= options_.queueDepth) {
-      ++rejectedBusy_;
-      refusal = busyAnswer(options_.queueDepth, retryAfterSecondsLocked());
+    } else if (std::optional<api::Answer> refused = admitLocked(*job)) {
+      refusal = std::move(*refused);
     } else {
       job->deadlineEntry = deadlines_.emplace(job->deadline, job);
-      queue_.push_back(job);
-      // Every idle slot checks whether it is the lowest-numbered one (nextJob).
-      workAvailable_.notify_all();
+      ++queuedByClient_[job->jobClass.client];
+      ++admitted_[laneIndex(job->lane)];
+      lanes_[laneIndex(job->lane)]->push(job);
+      dispatchLocked();
       // Only an earlier deadline than the watchdog's next one needs to wake it.
       if (job->deadlineEntry == deadlines_.begin()) deadlinesChanged_.notify_one();
       // The pool outlives the connections (HttpServer stops them first); the handle holds the
@@ -402,14 +501,127 @@ WorkerPool::Abandon WorkerPool::enqueue(std::shared_ptr<Job> job) {
   return {};
 }
 
+std::optional<api::Answer> WorkerPool::admitLocked(Job& job) {
+  job.estimateS = job.jobClass.referenceSeconds * std::exp(logSpeed_);
+  job.lane = job.jobClass.batch                       ? Lane::Batch
+             : job.estimateS >= options_.heavySeconds ? Lane::Heavy
+                                                      : Lane::Interactive;
+  const size_t queued = queuedLocked();
+  if (queued >= options_.queueDepth) {
+    ++rejectedBusy_;
+    ++refusals_["busy"];
+    return busyAnswer("the render queue is full (" + std::to_string(options_.queueDepth) +
+                          " waiting); retry later",
+                      "queueDepth", retryAfterSecondsLocked());
+  }
+  const size_t clientShare = options_.clientQueueDepth
+                                 ? options_.clientQueueDepth
+                                 : std::max<size_t>(1, options_.queueDepth / 2);
+  auto mine = queuedByClient_.find(job.jobClass.client);
+  if (job.lane != Lane::Batch && mine != queuedByClient_.end() && mine->second >= clientShare) {
+    double seconds = 0;
+    for (const auto& lane : lanes_) {
+      lane->forEach([&](const std::shared_ptr<Job>& j) {
+        if (j->jobClass.client == job.jobClass.client) seconds += j->estimateS;
+      });
+    }
+    ++rejectedBusy_;
+    ++refusals_["client"];
+    return busyAnswer("you have " + std::to_string(mine->second) +
+                          " requests waiting (clientQueueDepth " + std::to_string(clientShare) +
+                          "): other clients' requests go first; retry when yours are answered",
+                      "clientQueueDepth", drainSeconds(seconds, static_cast<int>(status_.size())));
+  }
+  const LaneQueue& heavy = *lanes_[laneIndex(Lane::Heavy)];
+  if (job.lane == Lane::Heavy && heavy.size > 0 &&
+      heavy.seconds + job.estimateS > options_.heavyQueueSeconds) {
+    ++rejectedBusy_;
+    ++refusals_["heavy"];
+    return busyAnswer("the heavy-request lane is full (about " +
+                          std::to_string(static_cast<int>(std::ceil(heavy.seconds))) +
+                          " s of heavy work waiting, heavyQueueMs " +
+                          std::to_string(static_cast<int>(options_.heavyQueueSeconds * 1000)) +
+                          "); small requests are still taken",
+                      "heavyQueueMs",
+                      drainSeconds(heavy.seconds + runningHeavySeconds_, generalSlots()));
+  }
+  return std::nullopt;
+}
+
+int WorkerPool::drainSeconds(double seconds, int workers) {
+  return static_cast<int>(std::clamp(std::ceil(seconds / std::max(workers, 1)), 1.0, 60.0));
+}
+
+int WorkerPool::generalSlots() const {
+  const int slots = static_cast<int>(status_.size());
+  return std::max(1, slots - std::max(0, options_.reservedInteractive));
+}
+
+size_t WorkerPool::queuedLocked() const {
+  size_t queued = 0;
+  for (const auto& lane : lanes_) queued += lane->size;
+  return queued;
+}
+
+int WorkerPool::idleSlotForLocked(Lane lane) const {
+  const int general = generalSlots();
+  if (lane != Lane::Interactive) {
+    auto slot = idle_.begin();
+    return slot != idle_.end() && static_cast<int>(*slot) < general ? static_cast<int>(*slot) : -1;
+  }
+  // Interactive work takes a reserved worker first, keeping the others for heavy work; the
+  // same one each time while it is free (its reference cache).
+  auto reserved = idle_.lower_bound(static_cast<size_t>(general));
+  if (reserved != idle_.end()) return static_cast<int>(*reserved);
+  return idle_.empty() ? -1 : static_cast<int>(*idle_.begin());
+}
+
+void WorkerPool::dispatchLocked() {
+  bool gave = false;
+  for (;;) {
+    const LaneQueue& heavy = *lanes_[laneIndex(Lane::Heavy)];
+    const bool heavyAged = heavy.size > 0 && Clock::now() - heavy.oldest() >= kHeavyAging;
+    const std::array<Lane, kLanes> order =
+        heavyAged ? std::array{Lane::Heavy, Lane::Interactive, Lane::Batch}
+                  : std::array{Lane::Interactive, Lane::Heavy, Lane::Batch};
+    bool given = false;
+    for (Lane lane : order) {
+      LaneQueue& queue = *lanes_[laneIndex(lane)];
+      if (queue.size == 0) continue;
+      const int slot = idleSlotForLocked(lane);
+      if (slot < 0) continue;
+      std::shared_ptr<Job> job = queue.pop();
+      if (auto mine = queuedByClient_.find(job->jobClass.client);
+          mine != queuedByClient_.end() && --mine->second == 0) {
+        queuedByClient_.erase(mine);
+      }
+      idle_.erase(static_cast<size_t>(slot));
+      assigned_[static_cast<size_t>(slot)] = std::move(job);
+      given = gave = true;
+      break;
+    }
+    if (!given) break;
+  }
+  if (gave) workAvailable_.notify_all();
+}
+
+void WorkerPool::unqueueLocked(const std::shared_ptr<Job>& job) {
+  // A job already given to a slot stays there: the slot sees it settled and skips it.
+  if (lanes_[laneIndex(job->lane)]->remove(job)) {
+    if (auto mine = queuedByClient_.find(job->jobClass.client);
+        mine != queuedByClient_.end() && --mine->second == 0) {
+      queuedByClient_.erase(mine);
+    }
+  }
+}
+
 void WorkerPool::abandon(const std::shared_ptr<Job>& job) {
   Reply reply;
   {
     std::lock_guard lock(mutex_);
     reply = claimLocked(*job);
     if (!reply) return;  // answered already
-    auto queued = std::find(queue_.begin(), queue_.end(), job);
-    if (queued != queue_.end()) queue_.erase(queued);
+    unqueueLocked(job);
     job->token.cancel();
     ++abandoned_;
     jobSettled_.notify_all();
@@ -429,40 +641,53 @@ WorkerPool::Reply WorkerPool::claimLocked(Job& job) {
 std::shared_ptr<WorkerPool::Job> WorkerPool::nextJob(size_t slot,
                                                      std::chrono::milliseconds wakeAfter) {
   std::unique_lock lock(mutex_);
-  idle_.insert(slot);
-  // The k-th lowest idle slot takes a job when at least k jobs wait: the lowest idle slot
-  // always gets the front one.
-  auto mine = [&] {
-    const size_t rank = static_cast<size_t>(std::distance(idle_.begin(), idle_.find(slot)));
-    return rank < queue_.size();
-  };
-  const bool woken =
-      wakeAfter.count() > 0
-          ? workAvailable_.wait_for(lock, wakeAfter, [&] { return stopping_ || mine(); })
-          : (workAvailable_.wait(lock, [&] { return stopping_ || mine(); }), true);
-  idle_.erase(slot);
-  if (stopping_ || !woken) return nullptr;
-  std::shared_ptr<Job> job = std::move(queue_.front());
-  queue_.pop_front();
-  running_.insert(job);
-  ++busyWorkers_;
-  status_[slot].busy = true;
-  status_[slot].endpoint = job->work ? "" : endpointPath(job->task.endpoint);
-  status_[slot].requestId = job->requestId;
-  return job;
+  const auto until = Clock::now() + wakeAfter;
+  for (;;) {
+    if (!assigned_[slot]) {
+      idle_.insert(slot);
+      dispatchLocked();
+    }
+    auto given = [&] { return stopping_ || assigned_[slot] != nullptr; };
+    const bool woken = wakeAfter.count() > 0 ? workAvailable_.wait_until(lock, until, given)
+                                             : (workAvailable_.wait(lock, given), true);
+    if (stopping_ || !woken) {
+      idle_.erase(slot);
+      return nullptr;
+    }
+    std::shared_ptr<Job> job = std::move(assigned_[slot]);
+    if (job->settled) continue;  // answered while it was on its way (abandoned, timed out)
+    running_.insert(job);
+    ++busyWorkers_;
+    ++runningByLane_[laneIndex(job->lane)];
+    if (job->lane == Lane::Heavy) runningHeavySeconds_ += job->estimateS;
+    status_[slot].busy = true;
+    status_[slot].endpoint = job->work ? "" : endpointPath(job->task.endpoint);
+    status_[slot].requestId = job->requestId;
+    return job;
+  }
 }
 
 void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::Answer answer,
                            Clock::time_point started, AfterJob after) {
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
   if (options_.metrics) {
-    options_.metrics->jobRan(std::chrono::duration<double>(started - job->queued).count(), seconds,
-                             answer);
+    options_.metrics->jobRan(laneName(job->lane),
+                             std::chrono::duration<double>(started - job->queued).count(), seconds,
+                             answer, job->estimateS);
   }
   Reply reply;
   {
     std::lock_guard lock(mutex_);
     --busyWorkers_;
+    --runningByLane_[laneIndex(job->lane)];
+    if (job->lane == Lane::Heavy) {
+      runningHeavySeconds_ = std::max(0.0, runningHeavySeconds_ - job->estimateS);
+    }
+    // The estimates learn this machine's speed from the engine's jobs that ran to their end.
+    if (!job->work && job->jobClass.referenceSeconds > 0 && answer.status == 200) {
+      const double ratio = std::clamp(seconds / job->jobClass.referenceSeconds, 1e-3, 1e3);
+      logSpeed_ += 0.1 * (std::log(ratio) - logSpeed_);
+    }
     status_[slot].busy = false;
     status_[slot].endpoint = "";
     status_[slot].requestId = 0;
@@ -470,10 +695,11 @@ void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::An
     renderSecondsSum_ += seconds;
     ++renderCount_;
     reply = claimLocked(*job);
-    if (after == AfterJob::TakesNext) idle_.insert(slot);
+    if (after == AfterJob::TakesNext) {
+      idle_.insert(slot);
+      dispatchLocked();
+    }
     jobSettled_.notify_all();
-    // A slot that went idle may now be the lowest-numbered one for a waiting job.
-    workAvailable_.notify_all();
   }
   job->work = nullptr;  // frees the request body now rather than when the last owner lets go
   job->task = {};
@@ -497,8 +723,7 @@ void WorkerPool::watchdogMain() {
     // The earliest job is due: settle it with 504 whether it waits or runs.
     std::shared_ptr<Job> job = deadlines_.begin()->second;
     Reply reply = claimLocked(*job);
-    auto queued = std::find(queue_.begin(), queue_.end(), job);
-    if (queued != queue_.end()) queue_.erase(queued);
+    unqueueLocked(job);
     job->token.cancel();  // a running worker stops at its next check
     ++timedOut_;
     jobSettled_.notify_all();
@@ -513,7 +738,10 @@ bool WorkerPool::drain(std::chrono::steady_clock::time_point deadline) {
   draining_ = true;
   // A job the watchdog answered 504 may still be running (cancelled): it has been answered.
   auto answered = [this] {
-    if (!queue_.empty()) return false;
+    if (queuedLocked() > 0) return false;
+    for (const auto& job : assigned_) {
+      if (job && !job->settled) return false;
+    }
     for (const auto& job : running_) {
       if (!job->settled) return false;
     }
@@ -529,10 +757,18 @@ void WorkerPool::stop() {
     if (stopping_) return;
     stopping_ = true;
     stopRequested_ = true;
-    for (auto& job : queue_) {
-      if (Reply reply = claimLocked(*job)) replies.push_back(std::move(reply));
+    for (const auto& lane : lanes_) {
+      lane->forEach([&](const std::shared_ptr<Job>& job) {
+        if (Reply reply = claimLocked(*job)) replies.push_back(std::move(reply));
+      });
+      lane->clear();
     }
-    queue_.clear();
+    queuedByClient_.clear();
+    for (const auto& job : assigned_) {
+      if (job) {
+        if (Reply reply = claimLocked(*job)) replies.push_back(std::move(reply));
+      }
+    }
     for (const auto& job : running_) {
       job->token.cancel();
       if (Reply reply = claimLocked(*job)) replies.push_back(std::move(reply));
@@ -568,10 +804,10 @@ void WorkerPool::join() {
 int WorkerPool::retryAfterSecondsLocked() const {
   // Roughly how long until a queue slot frees: the mean render time times the jobs ahead,
   // spread over the workers; at least one second, at most a minute.
-  const int ready = options_.workers - glFailures_;
+  const int ready = static_cast<int>(status_.size()) - glFailures_;
   if (renderCount_ == 0 || ready <= 0) return 1;
   double mean = renderSecondsSum_ / static_cast<double>(renderCount_);
-  double wait = mean * static_cast<double>(queue_.size() + busyWorkers_) / ready;
+  double wait = mean * static_cast<double>(queuedLocked() + busyWorkers_) / ready;
   return static_cast<int>(std::clamp(std::ceil(wait), 1.0, 60.0));
 }
 
@@ -586,7 +822,17 @@ PoolSnapshot WorkerPool::snapshot() const {
   s.workers = static_cast<int>(status_.size());
   for (const WorkerStatus& w : status_) s.readyWorkers += w.ready;
   s.busyWorkers = busyWorkers_;
-  s.queued = queue_.size();
+  s.queued = queuedLocked();
+  for (size_t l = 0; l < kLanes; ++l) {
+    s.queuedByLane[l] = lanes_[l]->size;
+    s.runningByLane[l] = runningByLane_[l];
+  }
+  int idleGeneral = 0;
+  for (size_t slot : idle_) idleGeneral += static_cast<int>(slot) < generalSlots();
+  s.freeForBatch = std::max(0, idleGeneral - static_cast<int>(s.queued));
+  s.speedFactor = std::exp(logSpeed_);
+  s.refusals = refusals_;
+  s.admitted = admitted_;
   s.queueCapacity = options_.queueDepth;
   s.stopping = stopping_;
   s.draining = draining_;

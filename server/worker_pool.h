@@ -10,10 +10,19 @@
 // with its own Rasterizer, as limn did before it had worker processes.
 //
 // The pool owns every rule about a job's life that does not depend on HTTP framing:
-//  - admission: a full queue answers 429 busy (with Retry-After) at once, a stopped pool or one
-//    without a single working GL context answers 503 unavailable;
-//  - dispatch: a job goes to the lowest-numbered idle worker, so that a client's requests in
-//    turn meet the same worker's reference cache;
+//  - lanes: a job is interactive, heavy (its estimated run time, corrected by the times the
+//    pool measures, is at least heavySeconds) or batch (a job's row group). Interactive jobs go
+//    first and may use every worker; heavy and batch jobs share all but reservedInteractive of
+//    them (so a small request never waits for a heavy one to finish), heavy before batch; a
+//    heavy job that has waited kHeavyAging goes before interactive ones for the workers it may
+//    use. Within a lane, clients take turns (one job each, round robin);
+//  - admission: a full queue answers 429 busy at once; so does a heavy job when the heavy work
+//    already waiting would take more than heavyQueueSeconds, and a client's job when that
+//    client already has clientQueueDepth waiting — each with a Retry-After computed from the
+//    estimated time for that work to drain. A stopped pool or one without a single working GL
+//    context answers 503 unavailable;
+//  - dispatch: a job goes to the lowest-numbered idle worker it may use, so that a client's
+//    requests in turn meet the same worker's reference cache;
 //  - deadline: each job gets a CancelToken with deadline now + timeout; a watchdog thread
 //    answers 504 timeout the moment the deadline passes, whether the job is still queued
 //    (it leaves the queue) or running (its token is cancelled and the worker drops its result;
@@ -27,6 +36,7 @@
 // (a worker, the watchdog, or the submitter for an immediate refusal).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -36,6 +46,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -57,6 +68,17 @@ namespace limn::server {
 
 enum class Isolation { Process, Thread };
 
+enum class Lane { Interactive, Heavy, Batch };
+inline constexpr size_t kLanes = 3;
+const char* laneName(Lane lane);
+
+// What the pool needs to know of a job before it queues it.
+struct JobClass {
+  bool batch = false;           // a job's row group (or a request that asked to be batch)
+  std::string client;           // who asked: clients take turns; "" is one anonymous client
+  double referenceSeconds = 0;  // api::referenceSeconds of its work (0: treated as small)
+};
+
 struct PoolOptions {
   int workers = 0;                            // 0 = one per core
   size_t queueDepth = 64;                     // jobs waiting, not counting running ones
@@ -73,6 +95,13 @@ struct PoolOptions {
   std::string workerExecutable = "/proc/self/exe";
   // Where each job's queue wait, run time and stage times are recorded; null: nowhere.
   ServiceMetrics* metrics = nullptr;
+  // Lanes (see above). Workers heavy and batch jobs may not take, when there are more workers
+  // than this; the corrected estimate from which a job is heavy; the estimated heavy work that
+  // may wait; the jobs one client may have waiting (0: half the queue, at least 1).
+  int reservedInteractive = 1;
+  double heavySeconds = 0.25;
+  double heavyQueueSeconds = 30;
+  size_t clientQueueDepth = 0;
 };
 
 // What one worker reported when it tried to make its GL context, and how it is now.
@@ -103,7 +132,17 @@ struct PoolSnapshot {
   size_t queued = 0;
   size_t queueCapacity = 0;
   bool stopping = false;
-  bool draining = false;   // shutting down: new work is refused 503
+  bool draining = false;  // shutting down: new work is refused 503
+  std::array<size_t, kLanes> queuedByLane{}, runningByLane{};
+  // Workers a batch job could start on now: idle ones heavy and batch work may use, less the
+  // jobs already waiting for one.
+  int freeForBatch = 0;
+  // Measured run time over api::referenceSeconds, learned from the jobs run so far.
+  double speedFactor = 1;
+  // Jobs refused at admission, by reason: "busy" (queue full), "heavy" (heavy lane full),
+  // "client" (the client's share full); and admitted, by lane.
+  std::map<std::string, size_t> refusals;
+  std::array<size_t, kLanes> admitted{};
   size_t renderCount = 0;  // jobs run to their end
   size_t rejectedBusy = 0, timedOut = 0, cancelled = 0;
   size_t abandoned = 0;     // jobs whose client went away before their answer
@@ -136,10 +175,10 @@ class WorkerPool {
   // Queues `task`; `reply` gets its answer, or the 429/503/504 the pool gives instead, or 500
   // worker_crashed naming `requestId` when its worker process dies. The returned handle
   // abandons the job (empty when the job was refused at once).
-  Abandon submit(Task task, Reply reply, uint64_t requestId = 0);
-  // The same for work run in the server process. `work` must not throw (a throw becomes 500
-  // internal anyway).
-  Abandon submitInServer(Work work, Reply reply);
+  Abandon submit(Task task, Reply reply, uint64_t requestId = 0, JobClass jobClass = {});
+  // The same for work run in the server process (interactive). `work` must not throw (a throw
+  // becomes 500 internal anyway).
+  Abandon submitInServer(Work work, Reply reply, std::string client = {});
 
   // Refuses new jobs (503) and waits until every queued and running job has been answered or
   // `deadline` passed; true when none is left.
@@ -176,15 +215,27 @@ class WorkerPool {
   void spareMain();
   // The spare for `slot`, or null when there is none (or it died waiting).
   std::unique_ptr<WorkerProcess> takeSpare(size_t slot);
-  // The next job for `slot` (the lowest-numbered idle slot takes the queue's front), or null
-  // when the pool stops or, with `wakeAfter`, when that passes first.
+  // The next job for `slot` (dispatchLocked gives it one), or null when the pool stops or,
+  // with `wakeAfter`, when that passes first.
   std::shared_ptr<Job> nextJob(size_t slot, std::chrono::milliseconds wakeAfter = {});
+  // Gives waiting jobs to idle slots, by the lanes' rules (above).
+  void dispatchLocked();
+  // The lowest idle slot that may run a job of `lane`, or -1.
+  int idleSlotForLocked(Lane lane) const;
+  // Takes a job that has not started out of its lane or its slot (abandoned, timed out).
+  void unqueueLocked(const std::shared_ptr<Job>& job);
+  // The lane a job joins, or the 429 it gets instead.
+  std::optional<api::Answer> admitLocked(Job& job);
+  size_t queuedLocked() const;
+  int generalSlots() const;  // the slots heavy and batch jobs may use: 0 .. generalSlots()-1
   // Counts the dead worker's end and starts its successor (null: none could be started).
   std::unique_ptr<WorkerProcess> replaceWorker(size_t slot, std::unique_ptr<WorkerProcess> dead,
                                                const WorkerProcess::Outcome& outcome);
   bool stopping() const;
   // How often an idle worker process is checked for having died between jobs.
   static constexpr std::chrono::milliseconds kIdleCheck{200};
+  // A heavy job waiting this long goes before interactive ones (it is not starved by them).
+  static constexpr std::chrono::milliseconds kHeavyAging{2000};
   // Runs `job` on the slot's thread (work in the server, or a task under Isolation::Thread).
   api::Answer runHere(Job& job, render::pipeline::RenderContext& context);
   // What a slot does once its job is answered.
@@ -201,6 +252,8 @@ class WorkerPool {
   Reply claimLocked(Job& job);
   void abandon(const std::shared_ptr<Job>& job);
   int retryAfterSecondsLocked() const;
+  // Seconds for `seconds` of estimated work to drain through `workers` workers, 1..60.
+  static int drainSeconds(double seconds, int workers);
 
   PoolOptions options_;
   // Isolation::Thread: the one cache every thread shares.
@@ -216,10 +269,17 @@ class WorkerPool {
   std::condition_variable workAvailable_;
   std::condition_variable deadlinesChanged_;
   std::condition_variable jobSettled_;  // drain() and joinFor() wait on it
-  std::deque<std::shared_ptr<Job>> queue_;
+  struct LaneQueue;
+  std::array<std::unique_ptr<LaneQueue>, kLanes> lanes_;
+  std::map<std::string, size_t> queuedByClient_;
+  std::array<size_t, kLanes> runningByLane_{}, admitted_{};
+  std::map<std::string, size_t> refusals_;
+  double logSpeed_ = 0;             // log of the learned speed factor
+  double runningHeavySeconds_ = 0;  // estimated work of the heavy jobs running
   std::unordered_set<std::shared_ptr<Job>> running_;
-  std::vector<WorkerStatus> status_;  // by slot
-  std::set<size_t> idle_;             // slots waiting for a job, or about to (finishJob)
+  std::vector<WorkerStatus> status_;            // by slot
+  std::set<size_t> idle_;                       // slots waiting for a job, or about to (finishJob)
+  std::vector<std::shared_ptr<Job>> assigned_;  // by slot: given by dispatchLocked, not taken
   // Each worker process' reference cache as it last reported, and the lookups of those lost.
   std::vector<render::oracle::ReferenceSceneCache::Counters> referenceCounters_;  // by slot
   render::oracle::ReferenceSceneCache::Counters retiredReferenceLookups_;

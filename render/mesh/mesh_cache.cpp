@@ -51,4 +51,10 @@ MeshCache::Counters MeshCache::counters() const {
   return {hits_, misses_, evictions_, order_.size(), bytes_, capacityBytes_};
 }
 
+int MeshCache::facesOf(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  auto it = byId_.find(id);
+  return it == byId_.end() ? -1 : it->second->mesh->faceCount();
+}
+
 }  // namespace limn::render::mesh

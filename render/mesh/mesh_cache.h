@@ -32,6 +32,9 @@ class MeshCache {
   Stored put(ControlMesh mesh);
   // The mesh with this id, or null when it was never stored or has been evicted.
   std::shared_ptr<const ControlMesh> find(const std::string& id);
+  // The face count of the mesh with this id, or -1: a look that neither counts as a lookup nor
+  // refreshes the mesh (the scheduler's estimate of a request, before it runs).
+  int facesOf(const std::string& id) const;
 
   struct Counters {
     size_t hits = 0, misses = 0, evictions = 0, entries = 0, bytes = 0, capacityBytes = 0;

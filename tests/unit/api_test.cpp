@@ -1099,6 +1099,10 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_EQ(file.jobRetentionSeconds, builtIn.jobRetentionSeconds);
   EXPECT_TRUE(file.jobStore.empty());  // the SQLite file in the data folder
   EXPECT_EQ(file.jobLeaseSeconds, builtIn.jobLeaseSeconds);
+  EXPECT_EQ(file.reservedInteractiveWorkers, builtIn.reservedInteractiveWorkers);
+  EXPECT_EQ(file.heavyRequestMs, builtIn.heavyRequestMs);
+  EXPECT_EQ(file.heavyQueueMs, builtIn.heavyQueueMs);
+  EXPECT_EQ(file.clientQueueDepth, builtIn.clientQueueDepth);
 }
 
 TEST(Config, AuthTokenAndCorsOrigins) {

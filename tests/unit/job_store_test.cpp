@@ -152,18 +152,36 @@ TEST_P(JobStoreTest, HeartbeatsKeepALeaseAndNameCancelledJobs) {
   // Renewed every 300 ms, a 1 s lease outlives itself (a stall of 0.7 s would break this).
   auto a = replica("a", 1s), b = replica("b", 1s);
   const std::string id = a->create(jobOf(2), 8, 1h).job.id;
-  ASSERT_TRUE(a->claim());
+  std::optional<ClaimedGroup> mine = a->claim();
+  ASSERT_TRUE(mine);
+  const std::vector<std::pair<std::string, size_t>> held{{id, mine->group}};
   for (int i = 0; i < 5; ++i) {
     std::this_thread::sleep_for(300ms);
-    EXPECT_TRUE(a->heartbeat().empty());
+    EXPECT_TRUE(a->heartbeat(held).empty());
   }
   std::optional<ClaimedGroup> other = b->claim();
   ASSERT_TRUE(other);  // the second group, not the renewed first
+  EXPECT_NE(other->group, mine->group);
   EXPECT_FALSE(b->claim());
   EXPECT_EQ(a->cancel(id)->state, "cancelled");
-  EXPECT_EQ(a->heartbeat(), std::vector<std::string>{id});
+  EXPECT_EQ(a->heartbeat(held), std::vector<std::string>{id});
   b->releaseAll();
   EXPECT_FALSE(b->claim());  // a cancelled job gives nothing more
+}
+
+// A lease the replica no longer works on (its rows could not be stored while the store was
+// lost) is handed back by the next heartbeat, not renewed forever.
+TEST_P(JobStoreTest, AHeartbeatHandsBackTheLeasesItNoLongerWorksOn) {
+  auto a = replica("a"), b = replica("b");
+  a->create(jobOf(1), 8, 1h);
+  std::optional<ClaimedGroup> lost = a->claim();
+  ASSERT_TRUE(lost);
+  EXPECT_FALSE(b->claim());
+  EXPECT_TRUE(a->heartbeat({}).empty());
+  std::optional<ClaimedGroup> again = b->claim();
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->group, lost->group);
+  EXPECT_EQ(again->attempts, 1) << "handing it back is not the group's fault";
 }
 
 TEST_P(JobStoreTest, AReleasedGroupWaitsItsDelayAndAShutdownDoesNotCountAsAnAttempt) {
