@@ -22,7 +22,7 @@ struct ServiceConfig {
   // Lanes (server/worker_pool.h): workers kept for interactive requests (heavy and batch work
   // takes the others), the estimated run time from which a request is heavy, the estimated heavy
   // work that may wait before heavy requests get 429, and the requests one client may have
-  // waiting (0: half of queueDepth).
+  // waiting (0: once the queue is half full, an equal share among the clients waiting).
   int reservedInteractiveWorkers = 1;
   int heavyRequestMs = 250;
   int heavyQueueMs = 30000;

@@ -56,14 +56,15 @@ bool isLoop(const Value* mesh) {
 }
 
 // The triangles one method makes of `faces` control faces at `pixels` of image.
-double methodTriangles(const Value* methodValue, const Value* params, double faces,
-                       double pixels, bool loop) {
+double methodTriangles(const Value* methodValue, const Value* params, double faces, double pixels,
+                       bool loop) {
   std::string method = "adaptive";
   if (methodValue && methodValue->IsString()) method = methodValue->GetString();
   const double perFace = loop ? 1.0 : 2.0;  // triangles of one face at level 0
   if (method == "coarse") return faces * perFace;
   if (method == "uniform") {
-    const double level = std::clamp(numberOr(params ? member(*params, "level") : nullptr, 3), 0.0, 8.0);
+    const double level =
+        std::clamp(numberOr(params ? member(*params, "level") : nullptr, 3), 0.0, 8.0);
     return faces * perFace * std::pow(4.0, level);
   }
   // Adaptive dicing (adaptive, limit, silhouette, patches): bounded by the screen, about two
@@ -127,12 +128,14 @@ WorkSize estimateWork(std::string_view path, std::string_view body,
     work.implicitCells = std::pow(std::clamp(resolution, 1.0, 4096.0), 3);
     work.pixels = pixels;
     const Value* reference = member(root, "reference");
-    if (reference && reference->IsBool() && reference->GetBool()) work.referencePixels = pixels * 16;
+    if (reference && reference->IsBool() && reference->GetBool())
+      work.referencePixels = pixels * 16;
     return work;
   }
   const Value* params = member(root, "params");
   double frames = 1;
-  if (const Value* f = member(root, "frames"); f && f->IsArray()) frames = std::max<double>(1, f->Size());
+  if (const Value* f = member(root, "frames"); f && f->IsArray())
+    frames = std::max<double>(1, f->Size());
   work.pixels = pixels * frames;
   work.triangles = methodTriangles(member(root, "method"), params, work.controlFaces, pixels, loop);
   const Value* reference = member(root, "reference");

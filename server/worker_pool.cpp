@@ -514,11 +514,16 @@ std::optional<api::Answer> WorkerPool::admitLocked(Job& job) {
                           " waiting); retry later",
                       "queueDepth", retryAfterSecondsLocked());
   }
-  const size_t clientShare = options_.clientQueueDepth
-                                 ? options_.clientQueueDepth
-                                 : std::max<size_t>(1, options_.queueDepth / 2);
+  // A client's share: clientQueueDepth when set; else, once the queue is half full, an equal
+  // share of it among the clients with requests waiting (a lone client may fill it all).
   auto mine = queuedByClient_.find(job.jobClass.client);
-  if (job.lane != Lane::Batch && mine != queuedByClient_.end() && mine->second >= clientShare) {
+  const size_t held = mine == queuedByClient_.end() ? 0 : mine->second;
+  const size_t clients = queuedByClient_.size() + (held == 0 ? 1 : 0);
+  const size_t share = options_.clientQueueDepth
+                           ? options_.clientQueueDepth
+                           : std::max<size_t>(1, options_.queueDepth / clients);
+  const bool contended = options_.clientQueueDepth || queued >= options_.queueDepth / 2;
+  if (job.lane != Lane::Batch && contended && held >= share) {
     double seconds = 0;
     for (const auto& lane : lanes_) {
       lane->forEach([&](const std::shared_ptr<Job>& j) {
@@ -527,9 +532,9 @@ std::optional<api::Answer> WorkerPool::admitLocked(Job& job) {
     }
     ++rejectedBusy_;
     ++refusals_["client"];
-    return busyAnswer("you have " + std::to_string(mine->second) +
-                          " requests waiting (clientQueueDepth " + std::to_string(clientShare) +
-                          "): other clients' requests go first; retry when yours are answered",
+    return busyAnswer("you have " + std::to_string(held) + " requests waiting, your share of " +
+                          "the queue while others wait (clientQueueDepth " + std::to_string(share) +
+                          "); retry when yours are answered",
                       "clientQueueDepth", drainSeconds(seconds, static_cast<int>(status_.size())));
   }
   const LaneQueue& heavy = *lanes_[laneIndex(Lane::Heavy)];

@@ -18,9 +18,10 @@
 //    use. Within a lane, clients take turns (one job each, round robin);
 //  - admission: a full queue answers 429 busy at once; so does a heavy job when the heavy work
 //    already waiting would take more than heavyQueueSeconds, and a client's job when that
-//    client already has clientQueueDepth waiting — each with a Retry-After computed from the
-//    estimated time for that work to drain. A stopped pool or one without a single working GL
-//    context answers 503 unavailable;
+//    client already holds its share of the queue (clientQueueDepth; by default, once the queue
+//    is half full, an equal share among the clients waiting) — each with a Retry-After
+//    computed from the estimated time for that work to drain. A stopped pool or one without a
+//    single working GL context answers 503 unavailable;
 //  - dispatch: a job goes to the lowest-numbered idle worker it may use, so that a client's
 //    requests in turn meet the same worker's reference cache;
 //  - deadline: each job gets a CancelToken with deadline now + timeout; a watchdog thread
@@ -97,7 +98,8 @@ struct PoolOptions {
   ServiceMetrics* metrics = nullptr;
   // Lanes (see above). Workers heavy and batch jobs may not take, when there are more workers
   // than this; the corrected estimate from which a job is heavy; the estimated heavy work that
-  // may wait; the jobs one client may have waiting (0: half the queue, at least 1).
+  // may wait; the jobs one client may have waiting (0: once the queue is half full, an equal
+  // share of it among the clients waiting).
   int reservedInteractive = 1;
   double heavySeconds = 0.25;
   double heavyQueueSeconds = 30;

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Small requests against heavy ones (issue 25), measured in one run on this build: 8 clients of
+# small renders (a cube at 256^2, adaptive dicingRate 2, colour only) and 2 clients of heavy
+# renders (a 5,000-face torus at 1024^2, adaptive, with the exact reference), each group its own
+# wrk, against `limn serve` with its defaults (2 workers) on a free loopback port. Three runs:
+# small alone, heavy alone, both together. Prints one Markdown table: per group requests/s,
+# p50/p90/p99 latency, 429s, time-outs, other errors; and /metrics' cost-estimate ratios.
+#
+#   bench/lanes_bench.sh [DURATION] [extra limn serve flags...]     (default 60s)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+duration="${1:-60s}"
+shift $(( $# > 0 ? 1 : 0 ))
+command -v wrk >/dev/null || { echo "wrk is not installed (apt-get install wrk)" >&2; exit 1; }
+work=$(mktemp -d)
+server=0
+trap 'kill $server 2>/dev/null || true; rm -rf "$work"' EXIT
+
+/usr/bin/python3 - "$work" <<'PY'
+import json, math, sys
+out = sys.argv[1]
+cube = ("v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\n"
+        "f 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n")
+json.dump({"mesh": {"format": "obj", "data": cube}, "camera": {"width": 256, "height": 256},
+           "method": "adaptive", "params": {"dicingRate": 2}, "outputs": ["color"]},
+          open(f"{out}/small.json", "w"))
+U, V, R, r = 100, 50, 1.0, 0.35   # 5,000 quads
+lines = []
+for i in range(U):
+    for j in range(V):
+        u, v = 2 * math.pi * i / U, 2 * math.pi * j / V
+        lines.append(f"v {(R + r * math.cos(v)) * math.cos(u):.6f} {r * math.sin(v):.6f} "
+                     f"{(R + r * math.cos(v)) * math.sin(u):.6f}")
+for i in range(U):
+    for j in range(V):
+        a, b = i * V + j, ((i + 1) % U) * V + j
+        c, d = ((i + 1) % U) * V + (j + 1) % V, i * V + (j + 1) % V
+        lines.append(f"f {a + 1} {d + 1} {c + 1} {b + 1}")
+json.dump({"mesh": {"format": "obj", "data": "\n".join(lines) + "\n"},
+           "camera": {"width": 1024, "height": 1024, "eye": [0.5, 2.5, 2.5]},
+           "method": "adaptive", "outputs": ["color"], "reference": True},
+          open(f"{out}/heavy.json", "w"))
+PY
+
+for kind in small heavy; do
+  cat > "$work/$kind.lua" <<LUA
+local f = assert(io.open("$work/$kind.json", "rb"))
+wrk.method = "POST"
+wrk.body = f:read("*a")
+wrk.headers["Content-Type"] = "application/json"
+f:close()
+done = function(summary, latency)
+  io.write(string.format("ROW %.1f %.0f %.0f %.0f %d %d %d\n", summary.requests / (summary.duration / 1e6),
+    latency:percentile(50) / 1000, latency:percentile(90) / 1000, latency:percentile(99) / 1000,
+    summary.errors.status, summary.errors.timeout, summary.errors.connect + summary.errors.read + summary.errors.write))
+end
+LUA
+done
+
+start_server() {
+  printf '{"port": 0, "logLevel": "off"}' > "$work/config.json"
+  build/bin/limn serve --config "$work/config.json" --job-store sqlite::memory: "$@" > "$work/out" 2> "$work/err" &
+  server=$!
+  for _ in $(seq 300); do grep -q "listening on" "$work/out" && break; sleep 0.05; done
+  url=$(grep -o 'http://[^ ]*' "$work/out")
+  # Warm-up: the workers' first frames, and the speed the estimates learn.
+  for _ in 1 2 3; do curl -s -o /dev/null -X POST --data-binary @"$work/small.json" "$url/v1/render"; done
+  curl -s -o /dev/null -X POST --data-binary @"$work/heavy.json" "$url/v1/render"
+}
+stop_server() { kill -TERM $server; wait $server || true; }
+
+# wrk KIND CONNECTIONS -> "ROW rps p50 p90 p99 non2xx timeouts errors" in $work/KIND.row
+run_wrk() {
+  wrk -t1 -c"$2" -d"$duration" --timeout 10s -s "$work/$1.lua" "$url/v1/render" | grep '^ROW' > "$work/$1.row"
+}
+
+print_row() {  # SETUP GROUP
+  read -r _ rps p50 p90 p99 non2xx timeouts errors < "$work/$2.row"
+  echo "| $1 | $2 | $rps | $p50 | $p90 | $p99 | $non2xx | $timeouts | $errors |"
+}
+
+echo "| setup | clients | requests/s | p50 ms | p90 ms | p99 ms | non-2xx (429) | time-outs | errors |"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|"
+start_server "$@"; run_wrk small 8; print_row "small alone" small; stop_server
+start_server "$@"; run_wrk heavy 2; print_row "heavy alone" heavy; stop_server
+start_server "$@"
+run_wrk small 8 & small_pid=$!
+run_wrk heavy 2
+wait $small_pid
+print_row "mixed" small
+print_row "mixed" heavy
+echo
+echo "Cost estimate, measured over estimated run time (limn_cost_estimate_ratio, mixed run):"
+curl -s "$url/metrics" | grep -E '^limn_cost_estimate_ratio_(bucket|count)|^limn_cost_speed_factor|^limn_admission_refusals_total|^limn_admissions_total'
+stop_server
