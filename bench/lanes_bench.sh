@@ -7,6 +7,9 @@
 # p50/p90/p99 latency, 429s, time-outs, other errors; and /metrics' cost-estimate ratios.
 #
 #   bench/lanes_bench.sh [DURATION] [extra limn serve flags...]     (default 60s)
+#   LIMN_BENCH_CONFIG='"reservedInteractiveWorkers": 0, "heavyRequestMs": 1000000000'
+#       adds configuration keys (that one: one FIFO lane, as limn was before lanes)
+#   LIMN_BENCH_RUNS="mixed"   only the mixed run (default: "small heavy mixed")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 duration="${1:-60s}"
@@ -58,7 +61,7 @@ LUA
 done
 
 start_server() {
-  printf '{"port": 0, "logLevel": "off"}' > "$work/config.json"
+  printf '{"port": 0, "logLevel": "off"%s}' "${LIMN_BENCH_CONFIG:+, $LIMN_BENCH_CONFIG}" > "$work/config.json"
   build/bin/limn serve --config "$work/config.json" --job-store sqlite::memory: "$@" > "$work/out" 2> "$work/err" &
   server=$!
   for _ in $(seq 300); do grep -q "listening on" "$work/out" && break; sleep 0.05; done
@@ -81,8 +84,14 @@ print_row() {  # SETUP GROUP
 
 echo "| setup | clients | requests/s | p50 ms | p90 ms | p99 ms | non-2xx (429) | time-outs | errors |"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|"
-start_server "$@"; run_wrk small 8; print_row "small alone" small; stop_server
-start_server "$@"; run_wrk heavy 2; print_row "heavy alone" heavy; stop_server
+runs="${LIMN_BENCH_RUNS:-small heavy mixed}"
+if [[ " $runs " == *" small "* ]]; then
+  start_server "$@"; run_wrk small 8; print_row "small alone" small; stop_server
+fi
+if [[ " $runs " == *" heavy "* ]]; then
+  start_server "$@"; run_wrk heavy 2; print_row "heavy alone" heavy; stop_server
+fi
+[[ " $runs " == *" mixed "* ]] || exit 0
 start_server "$@"
 run_wrk small 8 & small_pid=$!
 run_wrk heavy 2
