@@ -11,7 +11,9 @@ namespace {
 uint8_t quantize(float v) {
   if (!(v > 0.0f)) return 0;  // also catches NaN
   if (v >= 1.0f) return 255;
-  return static_cast<uint8_t>(std::lround(v * 255.0f));
+  // Round half away from zero, as std::lround would, without its library call (a tenth of a
+  // small request's CPU time went to lround): in double, v * 255 + 0.5 is exact for a float v.
+  return static_cast<uint8_t>(static_cast<double>(v) * 255.0 + 0.5);
 }
 
 std::vector<uint8_t> clamped(const Image& image) {
