@@ -154,6 +154,7 @@ ServiceConfig parseConfig(std::string_view json, const std::string& source) {
   r.integer("heavyRequestMs", config.heavyRequestMs, 1);
   r.integer("heavyQueueMs", config.heavyQueueMs, 1);
   r.integer("clientQueueDepth", config.clientQueueDepth, 0);
+  r.integer("heavyWorkerNice", config.heavyWorkerNice, 0, 19);
   r.integer("ioThreads", config.ioThreads, 1, 256);
   r.size("maxBodyBytes", config.maxBodyBytes, 1);
   r.integer("requestTimeoutMs", config.requestTimeoutMs, 1);

@@ -27,6 +27,9 @@ struct ServiceConfig {
   int heavyRequestMs = 250;
   int heavyQueueMs = 30000;
   int clientQueueDepth = 0;
+  // The nice value (0-19) of the worker processes heavy and batch work may use, when workers
+  // are reserved for interactive requests: they yield the CPU to those.
+  int heavyWorkerNice = 10;
   int ioThreads = 1;  // threads running the HTTP connections
   // "process": each render worker is a child process (a crash costs one request); "thread":
   // threads of the server itself (for debugging).

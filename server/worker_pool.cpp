@@ -1,10 +1,12 @@
 #include "server/worker_pool.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <utility>
@@ -156,6 +158,17 @@ api::Answer crashAnswer(const WorkerProcess::Outcome& outcome, int pid, uint64_t
                            detail});
 }
 
+// Raises the nice value of every thread of process `pid` (threads it starts later inherit it
+// from theirs). Raising needs no privilege; nothing here ever lowers it again.
+void lowerPriority(int pid, int nice) {
+  std::error_code ec;
+  for (const auto& task :
+       std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+    const int tid = std::atoi(task.path().filename().c_str());
+    if (tid > 0) ::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), nice);
+  }
+}
+
 // How long a slot waits before it tries again to start a worker that would not start.
 constexpr std::chrono::seconds kRestartBackoff{1};
 
@@ -173,6 +186,7 @@ PoolOptions poolOptions(const api::ServiceConfig& config) {
   options.heavySeconds = config.heavyRequestMs / 1000.0;
   options.heavyQueueSeconds = config.heavyQueueMs / 1000.0;
   options.clientQueueDepth = static_cast<size_t>(config.clientQueueDepth);
+  options.heavyNice = config.heavyWorkerNice;
   return options;
 }
 
@@ -293,6 +307,12 @@ void WorkerPool::adoptLocked(size_t slot, const WorkerProcess& worker) {
   status.device = worker.ready().device;
   status.pid = worker.pid();
   ++status.starts;
+  // The workers heavy and batch jobs run on yield the CPU to the reserved interactive ones: a
+  // small request's worker then runs at nearly its own speed beside heavy renders.
+  const bool reserveExists = static_cast<int>(status_.size()) > generalSlots();
+  if (reserveExists && static_cast<int>(slot) < generalSlots() && options_.heavyNice > 0) {
+    lowerPriority(worker.pid(), options_.heavyNice);
+  }
 }
 
 std::unique_ptr<WorkerProcess> WorkerPool::startWorkerProcess(size_t slot) {

@@ -104,6 +104,9 @@ struct PoolOptions {
   double heavySeconds = 0.25;
   double heavyQueueSeconds = 30;
   size_t clientQueueDepth = 0;
+  // Isolation::Process with reserved workers: the nice value of the worker processes heavy and
+  // batch jobs may use (0: as the server's).
+  int heavyNice = 0;
 };
 
 // What one worker reported when it tried to make its GL context, and how it is now.

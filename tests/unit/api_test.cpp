@@ -1103,6 +1103,7 @@ TEST(Config, DefaultFileEqualsTheBuiltInDefaults) {
   EXPECT_EQ(file.heavyRequestMs, builtIn.heavyRequestMs);
   EXPECT_EQ(file.heavyQueueMs, builtIn.heavyQueueMs);
   EXPECT_EQ(file.clientQueueDepth, builtIn.clientQueueDepth);
+  EXPECT_EQ(file.heavyWorkerNice, builtIn.heavyWorkerNice);
 }
 
 TEST(Config, AuthTokenAndCorsOrigins) {
