@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <fstream>
 #include <future>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -155,6 +157,28 @@ TEST(Lanes, AFloodingClientGetsIts429sWhileAnotherClientsRequestPasses) {
   EXPECT_LE(mine.done, std::max(firstQueued.done, secondQueued.done)) << "clients take turns";
   EXPECT_EQ(busy.get().response.status, 200);
   EXPECT_EQ(metric(port, "limn_admission_refusals_total{reason=\"client\"}"), 1);
+  EXPECT_EQ(server.terminate(SIGTERM), 0);
+}
+
+// The nice value of a process's main thread (/proc/PID/stat, field 19).
+int niceOf(int pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), {});
+  std::istringstream fields(stat.substr(stat.rfind(')') + 2));  // after "pid (comm) "
+  std::string field;
+  for (int i = 3; i <= 19 && fields >> field; ++i) {
+    if (i == 19) return std::stoi(field);
+  }
+  return -100;
+}
+
+TEST(Lanes, TheWorkerHeavyWorkRunsOnYieldsTheCpuToTheInteractiveOne) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 2, "heavyWorkerNice": 7})");
+  auto health = parseJson(get(server.port(), "/healthz").body);
+  const auto& workers = health["workerStates"];
+  ASSERT_EQ(workers.Size(), 2u);
+  EXPECT_EQ(niceOf(workers[0]["pid"].GetInt()), 7) << "the worker heavy work may use";
+  EXPECT_EQ(niceOf(workers[1]["pid"].GetInt()), niceOf(server.pid())) << "the reserved worker";
   EXPECT_EQ(server.terminate(SIGTERM), 0);
 }
 
