@@ -7,13 +7,15 @@
 
 namespace limn::server {
 
+std::string digestHex(std::string_view text) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(XXH3_64bits(text.data(), text.size())));
+  return hex;
+}
+
 std::string clientOf(const std::string& authorization, const std::string& peer) {
-  if (authorization.empty()) return "peer:" + peer;
-  char text[17];
-  std::snprintf(
-      text, sizeof text, "%016llx",
-      static_cast<unsigned long long>(XXH3_64bits(authorization.data(), authorization.size())));
-  return std::string("token:") + text;
+  return authorization.empty() ? "peer:" + peer : "token:" + digestHex(authorization);
 }
 
 namespace {

@@ -21,6 +21,9 @@ namespace limn::server {
 // Who is asking, for fair shares of the queue, GET /v1/jobs and Idempotency-Key: a digest of
 // the Authorization header when the request carries one, else the peer's address.
 std::string clientOf(const std::string& authorization, const std::string& peer);
+// A short stable digest of `text`: 16 hex digits of XXH3-64 (not a secret's protection: a
+// token's digest only tells requests apart).
+std::string digestHex(std::string_view text);
 
 // Access-Control-Allow-Origin (and Vary: Origin) for an origin Access allowed.
 void addCorsHeaders(std::string_view origin, api::Answer& answer);

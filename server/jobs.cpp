@@ -1,15 +1,12 @@
 #include "server/jobs.h"
 
-#define XXH_INLINE_ALL
-#include <xxhash.h>
-
-#include <cstdio>
 #include <iostream>
 
 #include "api/batch_results.h"
 #include "api/jobs_api.h"
 #include "api/json_util.h"
 #include "batch/report.h"
+#include "server/access.h"
 #include "server/tasks.h"
 
 namespace limn::server {
@@ -31,12 +28,6 @@ struct JobManager::Finished {
 };
 
 namespace {
-
-std::string hex64(uint64_t value) {
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
-  return text;
-}
 
 api::Answer notFound(const std::string& id) {
   return api::errorAnswer({404, "not_found",
@@ -152,7 +143,7 @@ api::Answer JobManager::create(std::string_view body, const std::string& client,
     batch::NewJob job;
     job.client = client;
     job.idempotencyKey = idempotencyKey;
-    job.requestHash = hex64(XXH3_64bits(body.data(), body.size()));
+    job.requestHash = digestHex(body);
     job.spec = api::storedSpec(body, *plan);
     job.totalRows = plan->rows().size();
     for (api::RowGroup& group : plan->pendingGroups({}, {}, limits_.maxCompareRows)) {

@@ -384,24 +384,18 @@ WorkerPool::Abandon Router::metricsText(const Route&, Request&, Reply& reply) {
       << "# HELP limn_queue_capacity Render jobs that may wait before requests get 429.\n"
          "# TYPE limn_queue_capacity gauge\n"
       << "limn_queue_capacity " << pool.queueCapacity << "\n";
-  out << "# HELP limn_lane_queue_depth Jobs waiting for a worker, by lane.\n"
-         "# TYPE limn_lane_queue_depth gauge\n";
-  for (size_t l = 0; l < kLanes; ++l) {
-    out << "limn_lane_queue_depth{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} "
-        << pool.queuedByLane[l] << "\n";
-  }
-  out << "# HELP limn_lane_running Jobs running on a worker, by lane.\n"
-         "# TYPE limn_lane_running gauge\n";
-  for (size_t l = 0; l < kLanes; ++l) {
-    out << "limn_lane_running{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} "
-        << pool.runningByLane[l] << "\n";
-  }
-  out << "# HELP limn_admissions_total Jobs admitted to a lane.\n"
-         "# TYPE limn_admissions_total counter\n";
-  for (size_t l = 0; l < kLanes; ++l) {
-    out << "limn_admissions_total{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} "
-        << pool.admitted[l] << "\n";
-  }
+  // One sample per lane of a family.
+  auto perLane = [&out](const char* name, const char* type, const char* help,
+                        const std::array<size_t, kLanes>& values) {
+    out << "# HELP " << name << " " << help << "\n# TYPE " << name << " " << type << "\n";
+    for (size_t l = 0; l < kLanes; ++l) {
+      out << name << "{lane=\"" << laneName(static_cast<Lane>(l)) << "\"} " << values[l] << "\n";
+    }
+  };
+  perLane("limn_lane_queue_depth", "gauge", "Jobs waiting for a worker, by lane.",
+          pool.queuedByLane);
+  perLane("limn_lane_running", "gauge", "Jobs running on a worker, by lane.", pool.runningByLane);
+  perLane("limn_admissions_total", "counter", "Jobs admitted to a lane.", pool.admitted);
   out << "# HELP limn_admission_refusals_total Jobs refused 429 at admission, by reason (busy: "
          "the queue, heavy: the heavy lane's budget, client: the client's share).\n"
          "# TYPE limn_admission_refusals_total counter\n";
