@@ -55,7 +55,23 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "setup: installing ${missing[*]}" >&2
   export DEBIAN_FRONTEND=noninteractive
   $sudo apt-get update -qq
+  # The postgresql package starts a default server when it is installed; limn's tests start
+  # their own (tests/support/postgres_cluster.h), and a machine without an init system may fail
+  # that start. Debian's policy-rc.d (exit 101: "not allowed") keeps any service from starting
+  # during this install; one that was there already is left alone.
+  policy=/usr/sbin/policy-rc.d
+  made_policy=""
+  if [ ! -e "$policy" ]; then
+    printf '#!/bin/sh\nexit 101\n' | $sudo tee "$policy" >/dev/null
+    $sudo chmod 755 "$policy"
+    made_policy=1
+    trap '$sudo rm -f "$policy"' EXIT
+  fi
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  if [ -n "$made_policy" ]; then
+    $sudo rm -f "$policy"
+    trap - EXIT
+  fi
 fi
 
 [ "$profile" = build ] && exit 0
