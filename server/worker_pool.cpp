@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -134,6 +135,12 @@ api::Answer busyAnswer(const std::string& message, const std::string& limit, int
 }
 
 size_t laneIndex(Lane lane) { return static_cast<size_t>(lane); }
+
+std::string milliseconds(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", seconds * 1000);
+  return text;
+}
 
 api::Answer timeoutAnswer(std::chrono::milliseconds timeout) {
   return api::errorAnswer({504, "timeout",
@@ -573,6 +580,13 @@ std::optional<api::Answer> WorkerPool::admitLocked(Job& job) {
   return std::nullopt;
 }
 
+std::string WorkerPool::serverTiming(const Job& job, double waitedS, double ranS) {
+  std::string timing = "queue;dur=" + milliseconds(waitedS) + ";desc=\"" + laneName(job.lane) +
+                       "\", run;dur=" + milliseconds(ranS);
+  if (job.estimateS > 0) timing += ", estimate;dur=" + milliseconds(job.estimateS);
+  return timing;
+}
+
 int WorkerPool::drainSeconds(double seconds, int workers) {
   return static_cast<int>(std::clamp(std::ceil(seconds / std::max(workers, 1)), 1.0, 60.0));
 }
@@ -695,11 +709,11 @@ std::shared_ptr<WorkerPool::Job> WorkerPool::nextJob(size_t slot,
 void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::Answer answer,
                            Clock::time_point started, AfterJob after) {
   const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  const double waited = std::chrono::duration<double>(started - job->queued).count();
   if (options_.metrics) {
-    options_.metrics->jobRan(laneName(job->lane),
-                             std::chrono::duration<double>(started - job->queued).count(), seconds,
-                             answer, job->estimateS);
+    options_.metrics->jobRan(laneName(job->lane), waited, seconds, answer, job->estimateS);
   }
+  answer.headers.emplace_back("Server-Timing", serverTiming(*job, waited, seconds));
   Reply reply;
   {
     std::lock_guard lock(mutex_);

@@ -257,6 +257,8 @@ class WorkerPool {
   Reply claimLocked(Job& job);
   void abandon(const std::shared_ptr<Job>& job);
   int retryAfterSecondsLocked() const;
+  // The Server-Timing header of a job's answer: its lane and wait, its run, its estimate (ms).
+  static std::string serverTiming(const Job& job, double waitedS, double ranS);
   // Seconds for `seconds` of estimated work to drain through `workers` workers, 1..60.
   static int drainSeconds(double seconds, int workers);
 

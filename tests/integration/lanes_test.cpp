@@ -94,7 +94,15 @@ TEST(Lanes, ASmallRequestIsAnsweredWhileAHeavyOneThatStartedFirstStillRuns) {
   HttpResponse small = post(port, "/v1/render", smallBody());
   const auto answered = Clock::now();
   ASSERT_EQ(small.status, 200) << small.body.substr(0, 300);
+  // Its answer says where its time went (W3C Server-Timing): the lane and the wait, the run,
+  // the estimate.
+  const std::string timing = small.header("Server-Timing");
+  EXPECT_NE(timing.find("queue;dur="), std::string::npos) << timing;
+  EXPECT_NE(timing.find("desc=\"interactive\""), std::string::npos) << timing;
+  EXPECT_NE(timing.find("run;dur="), std::string::npos) << timing;
+  EXPECT_NE(timing.find("estimate;dur="), std::string::npos) << timing;
   Timed first = heavy.get();
+  EXPECT_NE(first.response.header("Server-Timing").find("desc=\"heavy\""), std::string::npos);
   ASSERT_EQ(first.response.status, 200) << first.response.body.substr(0, 300);
   EXPECT_LT(answered, first.done) << "the small request waited for the heavy one";
   EXPECT_EQ(second.get().response.status, 200);
