@@ -17,6 +17,7 @@
 #include "api/obj_reader.h"
 #include "api/openapi.h"
 #include "api/render_api.h"
+#include "api/work_estimate.h"
 #include "render/raster/rasterizer.h"
 #include "tests/support/corpus.h"
 
@@ -1286,3 +1287,41 @@ TEST(MeshExport, ObjAndPlyCarryEveryVertexNormalAndTriangle) {
 }
 
 }  // namespace
+
+// The scheduler's estimate of a request, read from its JSON alone (api/work_estimate.h).
+TEST(WorkEstimate, ReadsSizesFromTheRequestAndRanksSmallBelowHeavy) {
+  const std::string cube =
+      R"({"format":"obj","data":"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 4 3 2 1\n"})";
+  auto none = [](const std::string&) { return -1; };
+  api::WorkSize preview = api::estimateWork(
+      "/v1/render",
+      R"({"mesh":)" + cube + R"(,"camera":{"width":256,"height":256},"method":"coarse"})", none);
+  EXPECT_EQ(preview.controlFaces, 2);
+  EXPECT_EQ(preview.pixels, 256.0 * 256.0);
+  EXPECT_EQ(preview.referencePixels, 0);
+  EXPECT_EQ(preview.triangles, 4);
+  api::WorkSize compared = api::estimateWork(
+      "/v1/render",
+      R"({"mesh":)" + cube +
+          R"(,"camera":{"width":2048,"height":2048},"method":"uniform","params":{"level":5},"reference":true})",
+      none);
+  EXPECT_EQ(compared.referencePixels, 2048.0 * 2048.0 * 16);  // metricSupersample 4 by default
+  EXPECT_EQ(compared.triangles, 2 * 2 * 1024.0);              // 2 quads, 2 triangles, 4^5
+  EXPECT_LT(api::referenceSeconds(preview), 0.05);
+  EXPECT_GT(api::referenceSeconds(compared), 1.0);
+  // An uploaded mesh's faces come from the cache's record; /v1/compare counts every row.
+  api::WorkSize byId = api::estimateWork(
+      "/v1/compare",
+      R"({"mesh":{"id":"abc"},"cameras":[{"width":100,"height":100},{"width":100,"height":100}],)"
+      R"("methods":["coarse",{"method":"uniform","params":{"level":1}}]})",
+      [](const std::string& id) { return id == "abc" ? 50 : -1; });
+  EXPECT_EQ(byId.controlFaces, 50);
+  EXPECT_EQ(byId.pixels, 2 * 2 * 100.0 * 100.0);  // 2 rows x 2 cameras
+  EXPECT_EQ(byId.referencePixels, 2 * 100.0 * 100.0 * 16);
+  // Too large to read: heavy without a look; not JSON: the worker's 400, estimated small.
+  api::WorkSize huge =
+      api::estimateWork("/v1/render", std::string(api::kMaxReadBytes + 1, ' '), none);
+  EXPECT_TRUE(huge.unread);
+  EXPECT_GE(api::referenceSeconds(huge), 1.0);
+  EXPECT_LT(api::referenceSeconds(api::estimateWork("/v1/render", "{nope", none)), 0.01);
+}
