@@ -302,6 +302,23 @@ TEST(JobStoreLocations, AnUnknownLocationOrAnUnreachableServerIsNamed) {
   }
 }
 
+// A role that may connect but not create tables (PostgreSQL 15 grants no CREATE on the public
+// schema to other roles than its owner) is told so at start, naming the store.
+TEST(JobStorePostgres, ARoleWithoutRightsIsToldSoAtStart) {
+  const std::string uri = cluster().createDatabase();
+  openPostgres(uri)->query("CREATE ROLE limn_no_rights LOGIN");
+  std::string other = uri;
+  other.replace(other.find("user=postgres"), 13, "user=limn_no_rights");
+  try {
+    JobStore::open(other, "a");
+    FAIL() << "created tables without the right to";
+  } catch (const DatabaseError& e) {
+    EXPECT_FALSE(e.lost);
+    EXPECT_NE(std::string(e.what()).find("permission denied"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("PostgreSQL database"), std::string::npos) << e.what();
+  }
+}
+
 // A PostgreSQL server that goes away and comes back: calls fail as "lost" meanwhile, and the
 // same store object works again once ping() reconnects.
 TEST(JobStorePostgres, AServerThatGoesAwayIsLostUntilItComesBack) {
