@@ -19,31 +19,8 @@ work=$(mktemp -d)
 server=0
 trap 'kill $server 2>/dev/null || true; rm -rf "$work"' EXIT
 
-/usr/bin/python3 - "$work" <<'PY'
-import json, math, sys
-out = sys.argv[1]
-cube = ("v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\n"
-        "f 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n")
-json.dump({"mesh": {"format": "obj", "data": cube}, "camera": {"width": 256, "height": 256},
-           "method": "adaptive", "params": {"dicingRate": 2}, "outputs": ["color"]},
-          open(f"{out}/small.json", "w"))
-U, V, R, r = 100, 50, 1.0, 0.35   # 5,000 quads
-lines = []
-for i in range(U):
-    for j in range(V):
-        u, v = 2 * math.pi * i / U, 2 * math.pi * j / V
-        lines.append(f"v {(R + r * math.cos(v)) * math.cos(u):.6f} {r * math.sin(v):.6f} "
-                     f"{(R + r * math.cos(v)) * math.sin(u):.6f}")
-for i in range(U):
-    for j in range(V):
-        a, b = i * V + j, ((i + 1) % U) * V + j
-        c, d = ((i + 1) % U) * V + (j + 1) % V, i * V + (j + 1) % V
-        lines.append(f"f {a + 1} {d + 1} {c + 1} {b + 1}")
-json.dump({"mesh": {"format": "obj", "data": "\n".join(lines) + "\n"},
-           "camera": {"width": 1024, "height": 1024, "eye": [0.5, 2.5, 2.5]},
-           "method": "adaptive", "outputs": ["color"], "reference": True},
-          open(f"{out}/heavy.json", "w"))
-PY
+# The 5,000-face torus: 100 x 50 quads.
+/usr/bin/python3 bench/load/requests.py "$work" 100 50
 
 for kind in small heavy; do
   cat > "$work/$kind.lua" <<LUA

@@ -25,34 +25,7 @@ server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -rf "$LIMN_LOAD_DIR"' EXIT
 for _ in $(seq 100); do curl -sf "127.0.0.1:$port/readyz" >/dev/null && break; sleep 0.1; done
 
-/usr/bin/python3 - "$LIMN_LOAD_DIR" <<'PY'
-import json, math, sys
-out = sys.argv[1]
-cube = ("v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\n"
-        "f 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n")
-def write(name, request):
-    with open(f"{out}/{name}", "w") as f:
-        json.dump(request, f)
-write("small.json", {"mesh": {"format": "obj", "data": cube}, "camera": {"width": 256, "height": 256},
-                     "method": "adaptive", "params": {"dicingRate": 2}, "outputs": ["color"]})
-# A torus of 32 x 16 quads, seen from above at an angle.
-lines = []
-U, V, R, r = 32, 16, 1.0, 0.35
-for i in range(U):
-    for j in range(V):
-        u, v = 2 * math.pi * i / U, 2 * math.pi * j / V
-        lines.append(f"v {(R + r * math.cos(v)) * math.cos(u):.6f} {r * math.sin(v):.6f} "
-                     f"{(R + r * math.cos(v)) * math.sin(u):.6f}")
-for i in range(U):
-    for j in range(V):
-        a, b = i * V + j, ((i + 1) % U) * V + j
-        c, d = ((i + 1) % U) * V + (j + 1) % V, i * V + (j + 1) % V
-        lines.append(f"f {a + 1} {d + 1} {c + 1} {b + 1}")
-write("heavy.json", {"mesh": {"format": "obj", "data": "\n".join(lines) + "\n"},
-                     "camera": {"width": 1024, "height": 1024, "eye": [0.5, 2.5, 2.5]},
-                     "method": "adaptive", "outputs": ["color"], "reference": True})
-write("invalid.json", {"mesh": {"format": "obj", "data": "v 0 0 0\nv 1 0 0\nf 1 2 7\n"}})
-PY
+/usr/bin/python3 bench/load/requests.py "$LIMN_LOAD_DIR"
 
 pid_rss() { awk '/VmRSS/ {print $2}' "/proc/$server/status" 2>/dev/null || echo 0; }
 echo "idle RSS before: $(( $(pid_rss) / 1024 )) MiB"
