@@ -29,8 +29,8 @@ std::vector<size_t> splitIndices(const std::string& text) {
   return out;
 }
 
-// Version 1: jobs, their groups (the unit of a lease) and their rows.
-const char* const kSchemaV1[] = {
+// The current layout (version 2): jobs, their groups (the unit of a lease) and their rows.
+const char* const kSchema[] = {
     "CREATE TABLE limn_jobs ("
     " id TEXT PRIMARY KEY, seq BIGINT NOT NULL, client TEXT NOT NULL,"
     " idempotency_key TEXT NOT NULL,"
@@ -92,6 +92,25 @@ void insertMany(SqlDatabase& db, const std::string& head, const std::string& row
     }
     db.query(sql + tail, params);
   }
+}
+
+// Version 2 numbers jobs in creation order (limn_jobs.seq: two jobs made in the same
+// millisecond still list in order). Version-1 stores made before the column existed gain it,
+// numbered by creation time; the ones made after it already have it (the column went in before
+// the version was raised, so both layouts are called 1).
+void addCreationSequence(SqlDatabase& db) {
+  const bool postgres = db.dialect() == SqlDialect::Postgres;
+  const std::string columns =
+      postgres ? "SELECT COUNT(*) FROM information_schema.columns WHERE table_schema ="
+                 " current_schema() AND table_name = 'limn_jobs' AND column_name = 'seq'"
+               : "SELECT COUNT(*) FROM pragma_table_info('limn_jobs') WHERE name = 'seq'";
+  if (toInt(db.query(columns)[0][0]) != 0) return;
+  db.query("ALTER TABLE limn_jobs ADD COLUMN seq BIGINT NOT NULL DEFAULT 0");
+  db.query(
+      "UPDATE limn_jobs SET seq = (SELECT COUNT(*) FROM limn_jobs o WHERE o.created_ms <"
+      " limn_jobs.created_ms OR (o.created_ms = limn_jobs.created_ms AND o.id <= limn_jobs.id))");
+  db.query("DROP INDEX limn_jobs_by_client");
+  db.query("CREATE INDEX limn_jobs_by_client ON limn_jobs (client, seq)");
 }
 
 }  // namespace
@@ -175,7 +194,9 @@ void JobStore::migrate() {
                             false);
       }
       if (version < 1) {
-        for (const char* statement : kSchemaV1) db.query(statement);
+        for (const char* statement : kSchema) db.query(statement);
+      } else if (version < 2) {
+        addCreationSequence(db);
       }
       db.query("UPDATE limn_schema SET version = ?", {int64_t{kSchemaVersion}});
     });

@@ -92,7 +92,7 @@ class JobStore {
   const std::string& replica() const { return replica_; }
   std::chrono::milliseconds lease() const { return options_.lease; }
   std::string describe() const;
-  static constexpr int kSchemaVersion = 1;
+  static constexpr int kSchemaVersion = 2;
 
   // Drops the jobs finished before `retention`, makes room (the oldest finished job goes while
   // `maxJobs` are held), and inserts the job; or finds the client's job of the same key.

@@ -65,9 +65,15 @@ JobManager::JobManager(WorkerPool& pool, const render::pipeline::JobLimits& limi
 
 JobManager::~JobManager() { stop(); }
 
-bool JobManager::healthy() const {
+std::string JobManager::storeProblem() const {
   std::lock_guard lock(mutex_);
-  return healthy_;
+  return problem_;
+}
+
+void JobManager::markUnhealthy(const batch::DatabaseError& e) {
+  std::lock_guard lock(mutex_);
+  if (problem_.empty()) std::cerr << "limn: job store: " << e.what() << "\n";
+  problem_ = e.what();
 }
 
 JobManager::Counters JobManager::counters() const {
@@ -83,11 +89,7 @@ api::Answer JobManager::withStore(Fn&& fn) {
     return fn();
   } catch (const batch::DatabaseError& e) {
     if (!e.lost) return api::errorAnswer({500, "internal", std::string("job store: ") + e.what()});
-    {
-      std::lock_guard lock(mutex_);
-      if (healthy_) std::cerr << "limn: job store: " << e.what() << "\n";
-      healthy_ = false;
-    }
+    markUnhealthy(e);
     return storeUnavailable(e.what());
   }
 }
@@ -300,7 +302,7 @@ void JobManager::runLoop() {
       nextBeat = Clock::now() + beatEvery;
     }
     Claimed claimed = Claimed::Nothing;
-    if (!stopping_ && healthy_) {
+    if (!stopping_ && problem_.empty()) {
       lock.unlock();
       claimed = claimWork();
       lock.lock();
@@ -334,9 +336,7 @@ JobManager::Claimed JobManager::claimWork() {
       // meanwhile leaves the group leased, to be claimed again when the lease runs out.
       startGroup(std::move(*group));
     } catch (const batch::DatabaseError& e) {
-      std::lock_guard lock(mutex_);
-      if (healthy_) std::cerr << "limn: job store: " << e.what() << "\n";
-      healthy_ = false;
+      markUnhealthy(e);
       return Claimed::Nothing;
     }
   }
@@ -441,9 +441,7 @@ void JobManager::settle(Finished finished) {
     count(&Counters::stored);
   } catch (const batch::DatabaseError& e) {
     // The lease runs out and the group is claimed again; its rows are made once more.
-    std::lock_guard lock(mutex_);
-    if (healthy_) std::cerr << "limn: job store: " << e.what() << "\n";
-    healthy_ = false;
+    markUnhealthy(e);
   }
 }
 
@@ -452,7 +450,7 @@ void JobManager::heartbeat() {
     bool wasHealthy;
     {
       std::lock_guard lock(mutex_);
-      wasHealthy = healthy_;
+      wasHealthy = problem_.empty();
     }
     if (!wasHealthy) store_->ping();
     std::vector<std::pair<std::string, size_t>> held;
@@ -465,8 +463,8 @@ void JobManager::heartbeat() {
     std::vector<WorkerPool::Abandon> abandons;
     {
       std::lock_guard lock(mutex_);
-      if (!healthy_) std::cerr << "limn: job store: reachable again\n";
-      healthy_ = true;
+      if (!problem_.empty()) std::cerr << "limn: job store: reachable again\n";
+      problem_.clear();
       for (auto& [key, flight] : inFlight_) {
         if (flight->abandon &&
             std::find(stopped.begin(), stopped.end(), key.first) != stopped.end())
@@ -475,9 +473,7 @@ void JobManager::heartbeat() {
     }
     for (auto& abandon : abandons) abandon();
   } catch (const batch::DatabaseError& e) {
-    std::lock_guard lock(mutex_);
-    if (healthy_) std::cerr << "limn: job store: " << e.what() << "\n";
-    healthy_ = false;
+    markUnhealthy(e);
   }
 }
 

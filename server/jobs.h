@@ -12,8 +12,8 @@
 // crashed its worker twice is stored as error rows naming the crash. On shutdown the runner
 // gives its leases back, uncounted, for the next replica or restart.
 //
-// A store that cannot be reached makes /v1/jobs answer 503 (Retry-After) and healthy() false
-// (/readyz); renders go on, and the runner keeps trying it. Thread-safe.
+// A store that cannot be reached makes /v1/jobs answer 503 (Retry-After) and /readyz name its
+// error (storeProblem()); renders go on, and the runner keeps trying it. Thread-safe.
 #pragma once
 
 #include <chrono>
@@ -67,7 +67,8 @@ class JobManager {
   api::Answer results(const std::string& id, const std::string& format);
 
   // Whether the store answered its last round trip.
-  bool healthy() const;
+  // Empty while the store answers; else why it does not (its last error).
+  std::string storeProblem() const;
   // For /metrics: this replica's row groups by what became of them, and those in flight.
   struct Counters {
     size_t stored = 0;    // rows stored (with or without errors)
@@ -94,6 +95,8 @@ class JobManager {
   void count(size_t Counters::*counter);
   void heartbeat();
   std::shared_ptr<const api::BatchPlan> planOf(const std::string& jobId);
+  // Logs the store's error once and keeps it for /readyz until a heartbeat gets through.
+  void markUnhealthy(const batch::DatabaseError& e);
   // Runs a store call; a lost store is 503, and marks the store unhealthy until a ping works.
   template <typename Fn>
   api::Answer withStore(Fn&& fn);
@@ -107,7 +110,8 @@ class JobManager {
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  bool stopping_ = false, healthy_ = true;
+  bool stopping_ = false;
+  std::string problem_;     // the store's last error while it fails; empty when it answers
   bool workAdded_ = false;  // a job was created here: claim at once rather than at the next poll
   std::map<std::pair<std::string, size_t>, std::shared_ptr<InFlight>> inFlight_;
   std::deque<Finished> finished_;

@@ -366,8 +366,8 @@ WorkerPool::Abandon Router::readyz(const Route&, Request&, Reply& reply) {
     reason = "no render worker has an OpenGL context";
   } else if (pool.queued >= pool.queueCapacity) {
     reason = "render queue full";
-  } else if (jobs_ && !jobs_->healthy()) {
-    reason = "the job store cannot be reached";
+  } else if (std::string problem = jobs_ ? jobs_->storeProblem() : ""; !problem.empty()) {
+    reason = "the job store cannot be reached: " + problem;
   }
   if (reason.empty()) return answerNow(reply, jsonAnswer(200, "{\"ready\":true}"));
   return answerNow(reply, jsonAnswer(503, "{\"ready\":false,\"reason\":" +
@@ -455,7 +455,7 @@ WorkerPool::Abandon Router::metricsText(const Route&, Request&, Reply& reply) {
     const JobManager::Counters c = jobs_->counters();
     out << "# HELP limn_job_store_up Whether the job store answered its last round trip.\n"
            "# TYPE limn_job_store_up gauge\n"
-        << "limn_job_store_up " << (jobs_->healthy() ? 1 : 0) << "\n"
+        << "limn_job_store_up " << (jobs_->storeProblem().empty() ? 1 : 0) << "\n"
         << "# HELP limn_job_groups_in_flight Job row groups this replica is computing now.\n"
            "# TYPE limn_job_groups_in_flight gauge\n"
         << "limn_job_groups_in_flight " << c.inFlight << "\n"

@@ -260,7 +260,12 @@ TEST(DurableJobs, AStoreLostWhileServingIs503ForJobsWhileRendersGoOn) {
   EXPECT_EQ(lost.status, 503) << lost.body;
   EXPECT_TRUE(lost.has("Retry-After"));
   EXPECT_NE(lost.body.find("job store"), std::string::npos) << lost.body;
-  EXPECT_EQ(get(server.port(), "/readyz").status, 503);
+  // /readyz says why, with the store's own words (an operator reads it in the probe's log).
+  HttpResponse notReady = get(server.port(), "/readyz");
+  EXPECT_EQ(notReady.status, 503);
+  EXPECT_NE(notReady.body.find("the job store cannot be reached: "), std::string::npos)
+      << notReady.body;
+  EXPECT_NE(notReady.body.find("PostgreSQL"), std::string::npos) << notReady.body;
   EXPECT_NE(get(server.port(), "/metrics").body.find("\nlimn_job_store_up 0\n"), std::string::npos);
   HttpResponse render =
       post(server.port(), "/v1/render",

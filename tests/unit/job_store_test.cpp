@@ -237,6 +237,57 @@ TEST_P(JobStoreTest, ConcurrentReplicasNeverComputeAGroupTwice) {
   EXPECT_EQ(replica("reader")->find(id)->state, "done");
 }
 
+// The first published layout (schema version 1, before jobs had a creation sequence), as a
+// store made by that limn holds it: two jobs made in the same millisecond, one group each.
+void writeFirstLayout(SqlDatabase& db) {
+  for (const char* statement : {
+           "CREATE TABLE limn_schema (version BIGINT NOT NULL)",
+           "INSERT INTO limn_schema (version) VALUES (1)",
+           "CREATE TABLE limn_jobs (id TEXT PRIMARY KEY, client TEXT NOT NULL,"
+           " idempotency_key TEXT NOT NULL, request_hash TEXT NOT NULL, spec TEXT NOT NULL,"
+           " state TEXT NOT NULL, total_rows BIGINT NOT NULL, error TEXT NOT NULL,"
+           " created_ms BIGINT NOT NULL, finished_ms BIGINT NOT NULL)",
+           "CREATE INDEX limn_jobs_by_client ON limn_jobs (client, created_ms)",
+           "CREATE TABLE limn_job_groups (job_id TEXT NOT NULL, group_index BIGINT NOT NULL,"
+           " row_indices TEXT NOT NULL, state TEXT NOT NULL, lease_owner TEXT NOT NULL,"
+           " lease_until_ms BIGINT NOT NULL, attempts BIGINT NOT NULL,"
+           " available_ms BIGINT NOT NULL, PRIMARY KEY (job_id, group_index))",
+           "CREATE TABLE limn_job_rows (job_id TEXT NOT NULL, row_index BIGINT NOT NULL,"
+           " row_key TEXT NOT NULL, replica TEXT NOT NULL, failed BIGINT NOT NULL,"
+           " line TEXT NOT NULL, PRIMARY KEY (job_id, row_index))",
+           "INSERT INTO limn_jobs VALUES ('job-a', 'peer:1', '', 'h', '{}', 'queued', 3, '',"
+           " 5000, 0)",
+           "INSERT INTO limn_jobs VALUES ('job-b', 'peer:1', '', 'h', '{}', 'queued', 3, '',"
+           " 5000, 0)",
+           "INSERT INTO limn_job_groups VALUES ('job-a', 0, '0,1,2', 'pending', '', 0, 0, 0)",
+           "INSERT INTO limn_job_groups VALUES ('job-b', 0, '0,1,2', 'pending', '', 0, 0, 0)",
+       }) {
+    db.query(statement);
+  }
+}
+
+TEST_P(JobStoreTest, AStoreOfTheFirstLayoutIsMigratedWithItsJobs) {
+  {
+    auto db = GetParam() == "sqlite" ? openSqlite(location_.substr(7)) : openPostgres(location_);
+    writeFirstLayout(*db);
+  }
+  auto store = replica("a");
+  const std::string newest = store->create(jobOf(1, "peer:1"), 8, 1h).job.id;
+  JobPage page = store->list("peer:1", "", 10);
+  ASSERT_EQ(page.jobs.size(), 3u);
+  EXPECT_EQ(page.jobs[0].id, newest);
+  EXPECT_EQ(page.jobs[1].id, "job-b");
+  EXPECT_EQ(page.jobs[2].id, "job-a");
+  // Work goes on where the old limn left it: the oldest job's group first.
+  std::optional<ClaimedGroup> group = store->claim();
+  ASSERT_TRUE(group);
+  EXPECT_EQ(group->jobId, "job-a");
+  store->complete(*group, rowsOf(*group, "a"));
+  EXPECT_EQ(store->rows("job-a", 0, 100).size(), 3u);
+  // Opened again, it is the current layout: nothing migrates twice.
+  EXPECT_EQ(replica("b")->list("peer:1", "", 10).jobs.size(), 3u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, JobStoreTest, ::testing::Values("sqlite", "postgresql"),
                          [](const auto& info) { return info.param; });
 
