@@ -11,6 +11,7 @@
 //                 along the crease); corner: the vertex itself. Where a semi-sharp feature
 //                 turns smooth in this step the parent and child rules are blended by the
 //                 transition weight (sharpness.h).
+#include "render/core/parallel.h"
 #include "render/rules/sharpness.h"
 #include "render/rules/steps.h"
 
@@ -45,76 +46,78 @@ Vec3 maskPoint(Rule rule, const Topology& t, const std::vector<Vec3>& P, int v, 
   return P[v];
 }
 
+// The edge point of edge e, from the parent points and the face points.
+Vec3 edgePointOf(const Topology& t, const std::vector<Vec3>& P, const Vec3* facePoint, int e) {
+  const auto [a, b] = t.edgeVertices[e];
+  const float s = t.edgeSharpness[e];
+  std::span<const int> faces = t.edgeFacesOf(e);
+  if (isSharp(s)) {
+    // The edge point's own rule one level down: its two halves decide.
+    int sharpHalves = isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
+    if (sharpHalves == 2 || faces.size() != 2) return 0.5 * (P[a] + P[b]);
+  }
+  // Smooth weights: ends vw each, face points fw each.
+  double fw = 0.25, vw = 0.25;
+  const bool smoothTriangles = t.options.triangleSubdivision == mesh::TriangleSubdivision::Smooth;
+  if (smoothTriangles && (t.faceSize(faces[0]) == 3 || t.faceSize(faces[1]) == 3)) {
+    const double kTriangle = 0.470;  // OpenSubdiv's (and Hbr's) weight for a triangle
+    double f0 = t.faceSize(faces[0]) == 3 ? kTriangle : 0.25;
+    double f1 = t.faceSize(faces[1]) == 3 ? kTriangle : 0.25;
+    fw = 0.5 * (f0 + f1);
+    vw = 0.5 * (1.0 - 2.0 * fw);
+  }
+  if (isSharp(s)) {
+    // Semi-sharp, turning smooth in this step (or a Chaikin dart): blend by the sharpness.
+    const double w = s;
+    vw = w * 0.5 + (1.0 - w) * vw;
+    fw *= 1.0 - w;
+  }
+  return vw * (P[a] + P[b]) + fw * (facePoint[faces[0]] + facePoint[faces[1]]);
+}
+
+// The child of vertex v, by its parent and child rules.
+Vec3 vertexPointOf(const Topology& t, const std::vector<Vec3>& P, const Vec3* facePoint,
+                   const VertexRules& rules, int v) {
+  std::span<const int> faces = t.vertexFacesOf(v);
+  if (faces.empty()) return P[v];  // an isolated vertex stays where it is
+  Vec3 smooth{0, 0, 0};
+  const Rule pr = rules.parent[v], cr = rules.child[v];
+  if (pr == Rule::Smooth || pr == Rule::Dart || cr == Rule::Smooth || cr == Rule::Dart) {
+    const double n = static_cast<double>(faces.size());
+    Vec3 ring{0, 0, 0};
+    for (int e : t.vertexEdgesOf(v)) ring += P[t.otherVertex(e, v)];
+    for (int f : faces) ring += facePoint[f];
+    smooth = (n - 2.0) / n * P[v] + ring / (n * n);
+  }
+  const Vec3 parent = maskPoint(pr, t, P, v, smooth, false);
+  if (pr == Rule::Smooth || pr == Rule::Dart || pr == cr) return parent;
+  const double w = rules.transition[v];
+  return w * parent + (1.0 - w) * maskPoint(cr, t, P, v, smooth, true);
+}
+
 }  // namespace
 
+// Each loop writes one point per element and reads only points made before it: its chunks run
+// in parallel, and the result does not depend on the number of threads.
 std::vector<Vec3> catmullClarkPoints(const Topology& t, const std::vector<Vec3>& P) {
   const int V = t.vertexCount, F = t.faceCount(), E = t.edgeCount();
   std::vector<Vec3> out(static_cast<size_t>(V) + F + E);
   Vec3* facePoint = out.data() + V;
   Vec3* edgePoint = out.data() + V + F;
-
-  for (int f = 0; f < F; ++f) {
-    Vec3 sum{0, 0, 0};
-    for (int v : t.faceVerts(f)) sum += P[v];
-    facePoint[f] = sum / t.faceSize(f);
-  }
-
-  const bool smoothTriangles = t.options.triangleSubdivision == mesh::TriangleSubdivision::Smooth;
-  for (int e = 0; e < E; ++e) {
-    const auto [a, b] = t.edgeVertices[e];
-    const Vec3 mid = 0.5 * (P[a] + P[b]);
-    const float s = t.edgeSharpness[e];
-    std::span<const int> faces = t.edgeFacesOf(e);
-    if (isSharp(s)) {
-      // The edge point's own rule one level down: its two halves decide.
-      int sharpHalves = isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
-      if (sharpHalves == 2 || faces.size() != 2) {
-        edgePoint[e] = mid;
-        continue;
-      }
+  parallelFor(F, kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      Vec3 sum{0, 0, 0};
+      for (int v : t.faceVerts(f)) sum += P[v];
+      facePoint[f] = sum / t.faceSize(f);
     }
-    // Smooth weights: ends vw each, face points fw each.
-    double fw = 0.25, vw = 0.25;
-    if (smoothTriangles && (t.faceSize(faces[0]) == 3 || t.faceSize(faces[1]) == 3)) {
-      const double kTriangle = 0.470;  // OpenSubdiv's (and Hbr's) weight for a triangle
-      double f0 = t.faceSize(faces[0]) == 3 ? kTriangle : 0.25;
-      double f1 = t.faceSize(faces[1]) == 3 ? kTriangle : 0.25;
-      fw = 0.5 * (f0 + f1);
-      vw = 0.5 * (1.0 - 2.0 * fw);
-    }
-    if (isSharp(s)) {
-      // Semi-sharp, turning smooth in this step (or a Chaikin dart): blend by the sharpness.
-      const double w = s;
-      vw = w * 0.5 + (1.0 - w) * vw;
-      fw *= 1.0 - w;
-    }
-    edgePoint[e] = vw * (P[a] + P[b]) + fw * (facePoint[faces[0]] + facePoint[faces[1]]);
-  }
-
+  });
+  parallelFor(E, kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t e = begin; e < end; ++e) edgePoint[e] = edgePointOf(t, P, facePoint, e);
+  });
   const VertexRules rules = vertexRules(t);
-  for (int v = 0; v < V; ++v) {
-    std::span<const int> faces = t.vertexFacesOf(v);
-    if (faces.empty()) {  // an isolated vertex stays where it is
-      out[v] = P[v];
-      continue;
-    }
-    Vec3 smooth{0, 0, 0};
-    const Rule pr = rules.parent[v], cr = rules.child[v];
-    if (pr == Rule::Smooth || pr == Rule::Dart || cr == Rule::Smooth || cr == Rule::Dart) {
-      const double n = static_cast<double>(faces.size());
-      Vec3 ring{0, 0, 0};
-      for (int e : t.vertexEdgesOf(v)) ring += P[t.otherVertex(e, v)];
-      for (int f : faces) ring += facePoint[f];
-      smooth = (n - 2.0) / n * P[v] + ring / (n * n);
-    }
-    const Vec3 parent = maskPoint(pr, t, P, v, smooth, false);
-    if (pr == Rule::Smooth || pr == Rule::Dart || pr == cr) {
-      out[v] = parent;
-      continue;
-    }
-    const double w = rules.transition[v];
-    out[v] = w * parent + (1.0 - w) * maskPoint(cr, t, P, v, smooth, true);
-  }
+  parallelFor(V, kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) out[v] = vertexPointOf(t, P, facePoint, rules, v);
+  });
   return out;
 }
 

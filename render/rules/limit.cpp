@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "render/core/parallel.h"
 #include "render/rules/sharpness.h"
 #include "render/rules/steps.h"
 #include "render/rules/weights.h"
@@ -84,7 +85,7 @@ class LimitMasks {
   LimitMasks(const Topology& t, const std::vector<Vec3>& points)
       : t_(t), P_(points), scheme_(t.options.scheme) {}
 
-  void evaluate(int v, Limit& out) {
+  void evaluate(int v, Limit& out, bool cornerNormals) {
     orderedRing(t_, v, ring_);
     const int faces = static_cast<int>(ring_.faces.size());
     const int edges = static_cast<int>(ring_.edges.size());
@@ -118,6 +119,7 @@ class LimitMasks {
     out.tangent1[v] = tangents.t1;
     out.tangent2[v] = tangents.t2;
     out.normals[v] = unitCross(tangents);
+    if (!cornerNormals) return;
     for (int i = 0; i < faces; ++i) {
       out.cornerNormals[t_.faceOffsets[ring_.faces[i]] + ring_.corners[i]] = faceNormals_[i];
     }
@@ -232,18 +234,19 @@ bool hasNonQuad(const Topology& t) {
 
 }  // namespace
 
-Limit limitOf(const Level& level) {
+Limit limitOf(const Level& level, bool cornerNormals) {
   const Topology& t = level.topology;
   if (t.options.scheme == mesh::Scheme::CatmullClark && hasNonQuad(t)) {
     // The masks of a Catmull-Clark vertex read the diagonal corners of quads: go one level
     // down, where the vertex's child (same index) has the same limit.
     Level child = refine(level, Method::Masks);
-    Limit fine = limitOf(child);
+    Limit fine = limitOf(child, cornerNormals);
     Limit out;
     out.positions.assign(fine.positions.begin(), fine.positions.begin() + t.vertexCount);
     out.tangent1.assign(fine.tangent1.begin(), fine.tangent1.begin() + t.vertexCount);
     out.tangent2.assign(fine.tangent2.begin(), fine.tangent2.begin() + t.vertexCount);
     out.normals.assign(fine.normals.begin(), fine.normals.begin() + t.vertexCount);
+    if (!cornerNormals) return out;
     out.cornerNormals.resize(t.faceVertices.size());
     for (int f = 0; f < t.faceCount(); ++f) {
       for (int k = 0; k < t.faceSize(f); ++k) {
@@ -261,9 +264,12 @@ Limit limitOf(const Level& level) {
   out.tangent1.resize(t.vertexCount);
   out.tangent2.resize(t.vertexCount);
   out.normals.resize(t.vertexCount);
-  out.cornerNormals.assign(t.faceVertices.size(), Vec3{0, 0, 0});
-  LimitMasks masks(t, level.points);
-  for (int v = 0; v < t.vertexCount; ++v) masks.evaluate(v, out);
+  if (cornerNormals) out.cornerNormals.assign(t.faceVertices.size(), Vec3{0, 0, 0});
+  // Each vertex writes its own entries (and its own corners): the chunks run in parallel.
+  parallelFor(t.vertexCount, 8192, [&](size_t begin, size_t end) {
+    LimitMasks masks(t, level.points);
+    for (size_t v = begin; v < end; ++v) masks.evaluate(static_cast<int>(v), out, cornerNormals);
+  });
   return out;
 }
 

@@ -41,6 +41,8 @@ struct Limit {
   std::vector<Vec3> cornerNormals;       // per face corner (topology.faceOffsets), unit or zero
 };
 
-Limit limitOf(const Level& level);
+// cornerNormals false leaves Limit::cornerNormals empty (a mesh drawn with vertex normals
+// does not need them). Parallel; the result does not depend on the number of threads.
+Limit limitOf(const Level& level, bool cornerNormals = true);
 
 }  // namespace limn::render::rules

@@ -6,6 +6,7 @@
 //                 neighbour, with Loop's original beta(n) = (5/8 - (3/8 + 1/4 cos(2 pi/n))^2)/n
 //                 (beta(3) = 3/16, beta(6) = 1/16; OpenSubdiv uses this one, not Warren's
 //                 simplification); crease: 3/4 and 1/8, 1/8; corner: fixed.
+#include "render/core/parallel.h"
 #include "render/rules/sharpness.h"
 #include "render/rules/steps.h"
 #include "render/rules/weights.h"
@@ -45,6 +46,43 @@ int opposite(const Topology& t, int f, int e) {
   return t.faceVerts(f)[(k + 2) % 3];
 }
 
+// The edge point of edge e.
+Vec3 edgePointOf(const Topology& t, const std::vector<Vec3>& P, int e) {
+  const auto [a, b] = t.edgeVertices[e];
+  const float s = t.edgeSharpness[e];
+  std::span<const int> faces = t.edgeFacesOf(e);
+  if (isSharp(s)) {
+    int sharpHalves = isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
+    if (sharpHalves == 2 || faces.size() != 2) return 0.5 * (P[a] + P[b]);
+  }
+  double vw = 0.375, fw = 0.125;
+  if (isSharp(s)) {
+    const double w = s;
+    vw = w * 0.5 + (1.0 - w) * vw;
+    fw *= 1.0 - w;
+  }
+  return vw * (P[a] + P[b]) + fw * (P[opposite(t, faces[0], e)] + P[opposite(t, faces[1], e)]);
+}
+
+// The child of vertex v, by its parent and child rules.
+Vec3 vertexPointOf(const Topology& t, const std::vector<Vec3>& P, const VertexRules& rules, int v) {
+  std::span<const int> faces = t.vertexFacesOf(v);
+  if (faces.empty()) return P[v];
+  const Rule pr = rules.parent[v], cr = rules.child[v];
+  Vec3 smooth{0, 0, 0};
+  if (pr == Rule::Smooth || pr == Rule::Dart || cr == Rule::Smooth || cr == Rule::Dart) {
+    const int n = static_cast<int>(faces.size());
+    const double beta = loopBeta(n);
+    Vec3 ring{0, 0, 0};
+    for (int e : t.vertexEdgesOf(v)) ring += P[t.otherVertex(e, v)];
+    smooth = (1.0 - n * beta) * P[v] + beta * ring;
+  }
+  const Vec3 parent = maskPoint(pr, t, P, v, smooth, false);
+  if (pr == Rule::Smooth || pr == Rule::Dart || pr == cr) return parent;
+  const double w = rules.transition[v];
+  return w * parent + (1.0 - w) * maskPoint(cr, t, P, v, smooth, true);
+}
+
 }  // namespace
 
 std::vector<Vec3> loopPoints(const Topology& t, const std::vector<Vec3>& P) {
@@ -52,51 +90,13 @@ std::vector<Vec3> loopPoints(const Topology& t, const std::vector<Vec3>& P) {
   std::vector<Vec3> out(static_cast<size_t>(V) + E);
   Vec3* edgePoint = out.data() + V;
 
-  for (int e = 0; e < E; ++e) {
-    const auto [a, b] = t.edgeVertices[e];
-    const float s = t.edgeSharpness[e];
-    std::span<const int> faces = t.edgeFacesOf(e);
-    if (isSharp(s)) {
-      int sharpHalves = isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
-      if (sharpHalves == 2 || faces.size() != 2) {
-        edgePoint[e] = 0.5 * (P[a] + P[b]);
-        continue;
-      }
-    }
-    double vw = 0.375, fw = 0.125;
-    if (isSharp(s)) {
-      const double w = s;
-      vw = w * 0.5 + (1.0 - w) * vw;
-      fw *= 1.0 - w;
-    }
-    edgePoint[e] =
-        vw * (P[a] + P[b]) + fw * (P[opposite(t, faces[0], e)] + P[opposite(t, faces[1], e)]);
-  }
-
+  parallelFor(E, kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t e = begin; e < end; ++e) edgePoint[e] = edgePointOf(t, P, e);
+  });
   const VertexRules rules = vertexRules(t);
-  for (int v = 0; v < V; ++v) {
-    std::span<const int> faces = t.vertexFacesOf(v);
-    if (faces.empty()) {
-      out[v] = P[v];
-      continue;
-    }
-    const Rule pr = rules.parent[v], cr = rules.child[v];
-    Vec3 smooth{0, 0, 0};
-    if (pr == Rule::Smooth || pr == Rule::Dart || cr == Rule::Smooth || cr == Rule::Dart) {
-      const int n = static_cast<int>(faces.size());
-      const double beta = loopBeta(n);
-      Vec3 ring{0, 0, 0};
-      for (int e : t.vertexEdgesOf(v)) ring += P[t.otherVertex(e, v)];
-      smooth = (1.0 - n * beta) * P[v] + beta * ring;
-    }
-    const Vec3 parent = maskPoint(pr, t, P, v, smooth, false);
-    if (pr == Rule::Smooth || pr == Rule::Dart || pr == cr) {
-      out[v] = parent;
-      continue;
-    }
-    const double w = rules.transition[v];
-    out[v] = w * parent + (1.0 - w) * maskPoint(cr, t, P, v, smooth, true);
-  }
+  parallelFor(V, kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) out[v] = vertexPointOf(t, P, rules, v);
+  });
   return out;
 }
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include "render/core/parallel.h"
+#include "render/rules/steps.h"
+
 namespace limn::render::rules {
 
 float childEdgeSharpness(const Topology& t, int e, int v) {
@@ -41,28 +44,30 @@ VertexRules vertexRules(const Topology& t) {
   rules.child.resize(t.vertexCount);
   rules.transition.assign(t.vertexCount, 0.0f);
   const bool uniform = t.options.creaseMethod == mesh::CreaseMethod::Uniform;
-  for (int v = 0; v < t.vertexCount; ++v) {
-    const float vs = t.vertexSharpness[v], childVs = decaySharpness(vs);
-    int sharp = 0, childSharp = 0, transitions = 0;
-    float transitionSum = 0.0f;
-    if (isSharp(vs) && !isSharp(childVs)) {
-      transitions = 1;
-      transitionSum = vs;
-    }
-    for (int e : t.vertexEdgesOf(v)) {
-      const float s = t.edgeSharpness[e], childS = childEdgeSharpness(t, e, v);
-      sharp += isSharp(s);
-      childSharp += isSharp(childS);
-      // Uniform decay takes exactly the edges in (0, 1] to zero; Chaikin is asked directly.
-      if (isSharp(s) && (uniform ? s <= 1.0f : !isSharp(childS))) {
-        transitionSum += s;
-        ++transitions;
+  parallelFor(t.vertexCount, kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      const float vs = t.vertexSharpness[v], childVs = decaySharpness(vs);
+      int sharp = 0, childSharp = 0, transitions = 0;
+      float transitionSum = 0.0f;
+      if (isSharp(vs) && !isSharp(childVs)) {
+        transitions = 1;
+        transitionSum = vs;
       }
+      for (int e : t.vertexEdgesOf(v)) {
+        const float s = t.edgeSharpness[e], childS = childEdgeSharpness(t, e, v);
+        sharp += isSharp(s);
+        childSharp += isSharp(childS);
+        // Uniform decay takes exactly the edges in (0, 1] to zero; Chaikin is asked directly.
+        if (isSharp(s) && (uniform ? s <= 1.0f : !isSharp(childS))) {
+          transitionSum += s;
+          ++transitions;
+        }
+      }
+      rules.parent[v] = ruleOf(vs, sharp);
+      rules.child[v] = ruleOf(childVs, childSharp);
+      if (transitions > 0) rules.transition[v] = std::min(1.0f, transitionSum / transitions);
     }
-    rules.parent[v] = ruleOf(vs, sharp);
-    rules.child[v] = ruleOf(childVs, childSharp);
-    if (transitions > 0) rules.transition[v] = std::min(1.0f, transitionSum / transitions);
-  }
+  });
   return rules;
 }
 

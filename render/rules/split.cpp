@@ -1,6 +1,7 @@
 // Child topologies of the two splits, numbered as OpenSubdiv's Far numbers a uniform level
 // (refine.h): vertices of vertices, of faces (Catmull-Clark), of edges; edges inside faces,
 // then edge halves; faces in parent order.
+#include "render/core/parallel.h"
 #include "render/rules/sharpness.h"
 #include "render/rules/steps.h"
 
@@ -103,23 +104,25 @@ Topology splitToQuads(const Topology& p) {
   c.faceVertices.resize(4 * corners);
   c.faceEdges.resize(4 * corners);
   c.faceHole.resize(corners);
-  for (int f = 0; f < F; ++f) {
-    std::span<const int> fv = p.faceVerts(f), fe = p.faceEdgesOf(f);
-    const int n = static_cast<int>(fv.size()), base = p.faceOffsets[f];
-    for (int i = 0; i < n; ++i) {
-      const int prev = (i + n - 1) % n;
-      const int verts[4] = {fv[i], edgeChild0 + fe[i], faceChild0 + f, edgeChild0 + fe[prev]};
-      const int edges[4] = {halfAt(p, firstHalf, fe[i], fv[i]), base + i, base + prev,
-                            halfAt(p, firstHalf, fe[prev], fv[i])};
-      const int rotation = n == 4 ? i : 0;
-      const int q = base + i;
-      for (int j = 0; j < 4; ++j) {
-        c.faceVertices[4 * q + (j + rotation) % 4] = verts[j];
-        c.faceEdges[4 * q + (j + rotation) % 4] = edges[j];
+  parallelFor(F, kParallelGrain, [&](size_t f, size_t lastFace) {
+    for (; f < lastFace; ++f) {
+      std::span<const int> fv = p.faceVerts(f), fe = p.faceEdgesOf(f);
+      const int n = static_cast<int>(fv.size()), base = p.faceOffsets[f];
+      for (int i = 0; i < n; ++i) {
+        const int prev = (i + n - 1) % n;
+        const int verts[4] = {fv[i], edgeChild0 + fe[i], faceChild0 + f, edgeChild0 + fe[prev]};
+        const int edges[4] = {halfAt(p, firstHalf, fe[i], fv[i]), base + i, base + prev,
+                              halfAt(p, firstHalf, fe[prev], fv[i])};
+        const int rotation = n == 4 ? i : 0;
+        const int q = base + i;
+        for (int j = 0; j < 4; ++j) {
+          c.faceVertices[4 * q + (j + rotation) % 4] = verts[j];
+          c.faceEdges[4 * q + (j + rotation) % 4] = edges[j];
+        }
+        c.faceHole[q] = p.faceHole[f];
       }
-      c.faceHole[q] = p.faceHole[f];
     }
-  }
+  });
   c.completeAdjacency();
   for (int f = 0; f < F; ++f) {  // an inner edge lies between the children at its two sides
     const int n = p.faceSize(f), base = p.faceOffsets[f];

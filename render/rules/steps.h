@@ -10,6 +10,9 @@
 
 namespace limn::render::rules {
 
+// Elements per task of the parallel loops over a level's faces, edges and vertices.
+inline constexpr size_t kParallelGrain = 16384;
+
 // Catmull-Clark's split: every n-gon into n quads (a quad's children keep its orientation:
 // child i has the child of corner i at its corner i; other faces' children start there).
 Topology splitToQuads(const Topology& parent);

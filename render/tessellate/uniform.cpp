@@ -5,11 +5,12 @@
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
+#include <array>
 #include <cmath>
-#include <set>
 #include <string>
 
 #include "render/core/error.h"
+#include "render/core/parallel.h"
 #include "render/rules/limit.h"
 #include "render/rules/refine.h"
 #include "render/subdiv/far_limit.h"
@@ -22,12 +23,20 @@ namespace Far = OpenSubdiv::Far;
 
 namespace {
 
-// The last level of a refinement, whoever made it.
+// The last level of a refinement, whoever made it: its points, their limits and limit normals,
+// and the topology the mesh is assembled from, as flat offset + index arrays.
 struct Refined {
   std::vector<Vec3> points, limit, normals;  // normals: any length, or zero where unknown
   std::vector<int> faceOffsets{0}, faceVertices;
   std::vector<uint8_t> hole;
+  std::vector<std::array<int, 2>> edgeVertices;
+  std::vector<int> edgeFaceOffsets, edgeFaces;
+  std::vector<int> vertexFaceOffsets, vertexFaces;
+  int faceCount() const { return static_cast<int>(faceOffsets.size()) - 1; }
 };
+
+// Loops over this many elements per task: enough to amortise a task, few enough to balance.
+constexpr size_t kGrain = 16384;
 
 // Triangles the refined mesh will have: Loop splits every triangle into 4 per level;
 // Catmull-Clark and bilinear split an n-gon into n quads at the first level, each quad into 4
@@ -70,30 +79,64 @@ Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
   subdiv::limitOfLastLevel(*refiner, src, limit, du, dv);  // not PrimvarRefiner::Limit: far_limit.h
 
   Refined out;
-  for (int v = 0; v < vertexCount; ++v) {
-    out.points.push_back(src[v].p);
-    out.limit.push_back(limit[v].p);
-    out.normals.push_back(cross(du[v].p, dv[v].p));
-  }
-  for (int f = 0; f < last.GetNumFaces(); ++f) {
-    Far::ConstIndexArray fv = last.GetFaceVertices(f);
-    out.faceVertices.insert(out.faceVertices.end(), fv.begin(), fv.end());
-    out.faceOffsets.push_back(static_cast<int>(out.faceVertices.size()));
-    out.hole.push_back(last.IsFaceHole(f));
+  out.points.resize(vertexCount);
+  out.limit.resize(vertexCount);
+  out.normals.resize(vertexCount);
+  parallelFor(vertexCount, kGrain, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      out.points[v] = src[v].p;
+      out.limit[v] = limit[v].p;
+      out.normals[v] = cross(du[v].p, dv[v].p);
+    }
+  });
+  // Far's accessors hand out arrays of its own; copy them into flat offset + index arrays.
+  const auto flatten = [](int count, auto arrayOf, std::vector<int>& offsets,
+                          std::vector<int>& values) {
+    offsets.assign(count + 1, 0);
+    for (int i = 0; i < count; ++i) offsets[i + 1] = offsets[i] + arrayOf(i).size();
+    values.resize(offsets[count]);
+    parallelFor(count, kGrain, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        Far::ConstIndexArray a = arrayOf(static_cast<int>(i));
+        std::copy(a.begin(), a.end(), values.begin() + offsets[i]);
+      }
+    });
+  };
+  flatten(
+      last.GetNumFaces(), [&](int f) { return last.GetFaceVertices(f); }, out.faceOffsets,
+      out.faceVertices);
+  flatten(
+      last.GetNumEdges(), [&](int e) { return last.GetEdgeFaces(e); }, out.edgeFaceOffsets,
+      out.edgeFaces);
+  flatten(
+      vertexCount, [&](int v) { return last.GetVertexFaces(v); }, out.vertexFaceOffsets,
+      out.vertexFaces);
+  out.hole.resize(last.GetNumFaces());
+  for (int f = 0; f < last.GetNumFaces(); ++f) out.hole[f] = last.IsFaceHole(f);
+  out.edgeVertices.resize(last.GetNumEdges());
+  for (int e = 0; e < last.GetNumEdges(); ++e) {
+    Far::ConstIndexArray ev = last.GetEdgeVertices(e);
+    out.edgeVertices[e] = {ev[0], ev[1]};
   }
   return out;
 }
 
 Refined refineWithRules(const mesh::ControlMesh& cage, int level, rules::Method method) {
   rules::Level refined = rules::refineUniform(cage, level, method);
-  rules::Limit limit = rules::limitOf(refined);
+  rules::Limit limit = rules::limitOf(refined, /*cornerNormals=*/false);
   Refined out;
   out.points = std::move(refined.points);
   out.limit = std::move(limit.positions);
   out.normals = std::move(limit.normals);
-  out.faceOffsets = std::move(refined.topology.faceOffsets);
-  out.faceVertices = std::move(refined.topology.faceVertices);
-  out.hole = std::move(refined.topology.faceHole);
+  rules::Topology& t = refined.topology;
+  out.faceOffsets = std::move(t.faceOffsets);
+  out.faceVertices = std::move(t.faceVertices);
+  out.hole = std::move(t.faceHole);
+  out.edgeVertices = std::move(t.edgeVertices);
+  out.edgeFaceOffsets = std::move(t.edgeFaceOffsets);
+  out.edgeFaces = std::move(t.edgeFaces);
+  out.vertexFaceOffsets = std::move(t.vertexFaceOffsets);
+  out.vertexFaces = std::move(t.vertexFaces);
   if (level == 0) {
     // Level 0 is the cage, drawn as the OpenSubdiv engine draws it (tessellateCoarse): only
     // the mesh's own holes are left out, not the faces "none" boundaries give no limit.
@@ -103,47 +146,77 @@ Refined refineWithRules(const mesh::ControlMesh& cage, int level, rules::Method 
   return out;
 }
 
+// The mesh the rasteriser takes, every stage a parallel loop whose elements are written by one
+// task each (so the result does not depend on the number of threads): vertices, triangles
+// (faces fanned, holes left out), per-vertex limit normals turned to the side their faces face,
+// and the polygon edges of the faces drawn.
 TriangleMesh assemble(const Refined& r, bool pushToLimit) {
-  const int vertexCount = static_cast<int>(r.points.size());
+  const size_t vertexCount = r.points.size();
+  const int faceCount = r.faceCount();
   const std::vector<Vec3>& drawn = pushToLimit ? r.limit : r.points;
   TriangleMesh out;
-  out.positions.reserve(vertexCount);
-  for (int v = 0; v < vertexCount; ++v) {
-    out.positions.emplace_back(drawn[v]);
-    out.limitPositions.emplace_back(r.limit[v]);
-  }
+  out.positions.resize(vertexCount);
+  out.limitPositions.resize(vertexCount);
+  parallelFor(vertexCount, kGrain, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      out.positions[v] = Vec3f(drawn[v]);
+      out.limitPositions[v] = Vec3f(r.limit[v]);
+    }
+  });
 
-  // Faces, and per-vertex face normals to orient the limit normals consistently.
-  std::vector<Vec3> faceNormalSum(vertexCount, Vec3{0, 0, 0});
-  std::set<std::pair<int, int>> seen;
-  const int faceCount = static_cast<int>(r.faceOffsets.size()) - 1;
+  // Each face's fan: where its triangles start, and the face's area-weighted normal.
+  std::vector<uint32_t> firstTriangle(faceCount + 1, 0);
   for (int f = 0; f < faceCount; ++f) {
-    if (r.hole[f]) continue;
-    const int* fv = r.faceVertices.data() + r.faceOffsets[f];
     const int n = r.faceOffsets[f + 1] - r.faceOffsets[f];
-    for (int k = 1; k + 1 < n; ++k) {
-      out.indices.insert(out.indices.end(),
-                         {static_cast<uint32_t>(fv[0]), static_cast<uint32_t>(fv[k]),
-                          static_cast<uint32_t>(fv[k + 1])});
-      Vec3 normal = cross(drawn[fv[k]] - drawn[fv[0]], drawn[fv[k + 1]] - drawn[fv[0]]);
-      faceNormalSum[fv[0]] += normal;
-      faceNormalSum[fv[k]] += normal;
-      faceNormalSum[fv[k + 1]] += normal;
-    }
-    for (int k = 0; k < n; ++k) {
-      int a = fv[k], b = fv[(k + 1) % n];
-      if (seen.insert({std::min(a, b), std::max(a, b)}).second) {
-        out.lines.insert(out.lines.end(), {static_cast<uint32_t>(a), static_cast<uint32_t>(b)});
-      }
-    }
+    firstTriangle[f + 1] = firstTriangle[f] + (r.hole[f] ? 0 : n - 2);
   }
+  out.indices.resize(3 * size_t{firstTriangle[faceCount]});
+  std::vector<Vec3> faceNormal(faceCount);
+  parallelFor(faceCount, kGrain, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      if (r.hole[f]) continue;
+      const int* fv = r.faceVertices.data() + r.faceOffsets[f];
+      const int n = r.faceOffsets[f + 1] - r.faceOffsets[f];
+      uint32_t* triangle = out.indices.data() + 3 * size_t{firstTriangle[f]};
+      Vec3 normal{0, 0, 0};
+      for (int k = 1; k + 1 < n; ++k, triangle += 3) {
+        triangle[0] = static_cast<uint32_t>(fv[0]);
+        triangle[1] = static_cast<uint32_t>(fv[k]);
+        triangle[2] = static_cast<uint32_t>(fv[k + 1]);
+        normal += cross(drawn[fv[k]] - drawn[fv[0]], drawn[fv[k + 1]] - drawn[fv[0]]);
+      }
+      faceNormal[f] = normal;
+    }
+  });
+
+  // The limit normal, turned to the side of the faces around the vertex (the faces' own
+  // normal where the limit tangents are degenerate).
   out.normals.resize(vertexCount);
-  for (int v = 0; v < vertexCount; ++v) {
-    Vec3 n = normalize(r.normals[v]);
-    Vec3 around = faceNormalSum[v];
-    if (length(n) == 0) n = normalize(around);  // degenerate tangents: use the faces' normal
-    if (dot(n, around) < 0) n = -n;
-    out.normals[v] = Vec3f(n);
+  parallelFor(vertexCount, kGrain, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      Vec3 around{0, 0, 0};
+      for (int i = r.vertexFaceOffsets[v]; i < r.vertexFaceOffsets[v + 1]; ++i) {
+        if (!r.hole[r.vertexFaces[i]]) around += faceNormal[r.vertexFaces[i]];
+      }
+      Vec3 n = normalize(r.normals[v]);
+      if (length(n) == 0) n = normalize(around);
+      if (dot(n, around) < 0) n = -n;
+      out.normals[v] = Vec3f(n);
+    }
+  });
+
+  // The wireframe: every edge of a face that is drawn.
+  const auto drawnEdge = [&](size_t e) {
+    for (int i = r.edgeFaceOffsets[e]; i < r.edgeFaceOffsets[e + 1]; ++i) {
+      if (!r.hole[r.edgeFaces[i]]) return true;
+    }
+    return false;
+  };
+  out.lines.reserve(2 * r.edgeVertices.size());
+  for (size_t e = 0; e < r.edgeVertices.size(); ++e) {
+    if (!drawnEdge(e)) continue;
+    out.lines.push_back(static_cast<uint32_t>(r.edgeVertices[e][0]));
+    out.lines.push_back(static_cast<uint32_t>(r.edgeVertices[e][1]));
   }
   return out;
 }
