@@ -114,7 +114,7 @@ ParsedMethod parseCompareMethod(const Value& entry, const std::string& field,
                    "methods to compare with it");
   }
   if (method.method != Method::Uniform &&
-      (method.params.engine != render::pipeline::Engine::OpenSubdiv || method.params.pushToLimit)) {
+      (method.params.engine != render::pipeline::Engine::Auto || method.params.pushToLimit)) {
     warnings.push_back(field +
                        ".params.engine and pushToLimit are read by method \"uniform\" only; "
                        "ignored");

@@ -104,7 +104,8 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
   if (const Value* v = json::find(params, "engine")) {
     using render::pipeline::Engine;
     out.engine = json::choice<Engine>(*v, "params.engine",
-                                      {{"opensubdiv", Engine::OpenSubdiv},
+                                      {{"auto", Engine::Auto},
+                                       {"opensubdiv", Engine::OpenSubdiv},
                                        {"masks", Engine::Masks},
                                        {"factored", Engine::Factored}});
   }
@@ -304,7 +305,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
                "has none");
   }
   if (job.method != Method::Uniform &&
-      (job.params.engine != render::pipeline::Engine::OpenSubdiv || job.params.pushToLimit)) {
+      (job.params.engine != render::pipeline::Engine::Auto || job.params.pushToLimit)) {
     warnings.push_back(
         "params.engine and params.pushToLimit are read by method \"uniform\" "
         "only; ignored");

@@ -13,12 +13,21 @@
 
 namespace limn::render {
 
+// The most threads parallelFor uses; 0 (the default): one per hardware thread. For tests and
+// benchmarks that compare results or times on 1 and 2 threads.
+inline std::atomic<unsigned>& parallelThreadLimit() {
+  static std::atomic<unsigned> limit{0};
+  return limit;
+}
+
 template <typename Body>  // Body: void(size_t begin, size_t end)
 void parallelFor(size_t count, size_t grain, const Body& body) {
   if (count == 0) return;
   grain = std::max<size_t>(grain, 1);
   size_t chunks = (count + grain - 1) / grain;
   size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), chunks);
+  if (const unsigned limit = parallelThreadLimit().load())
+    threads = std::min<size_t>(threads, limit);
   if (threads <= 1) {
     body(0, count);
     return;

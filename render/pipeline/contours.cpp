@@ -29,6 +29,7 @@ ContourResult runContours(const ContourJob& job, const JobLimits& limits,
   cancel.check();
 
   const subdiv::LimitSurface surface(job.mesh, cancel);
+  surface.prepare(cancel);
   ContourResult result{.camera = resolveCamera(job.camera, surface.bounds()),
                        .polylines = {},
                        .stats = {},

@@ -60,10 +60,20 @@ tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobL
     case Method::Uniform: {
       tessellate::UniformOptions options;
       options.level = choice.params.level;
-      options.engine = choice.params.engine == Engine::Masks ? tessellate::UniformEngine::Masks
-                       : choice.params.engine == Engine::Factored
-                           ? tessellate::UniformEngine::Factored
-                           : tessellate::UniformEngine::OpenSubdiv;
+      switch (choice.params.engine) {
+        case Engine::Auto:
+          options.engine = tessellate::UniformEngine::Auto;
+          break;
+        case Engine::OpenSubdiv:
+          options.engine = tessellate::UniformEngine::OpenSubdiv;
+          break;
+        case Engine::Masks:
+          options.engine = tessellate::UniformEngine::Masks;
+          break;
+        case Engine::Factored:
+          options.engine = tessellate::UniformEngine::Factored;
+          break;
+      }
       options.pushToLimit = choice.params.pushToLimit;
       options.maxTriangles = limits.maxTriangles;
       return tessellate::tessellateUniform(surface, options);
@@ -281,7 +291,8 @@ void checkMethod(const MethodChoice& choice, const JobLimits& limits) {
                  "\"normal-map\" is available with methods \"silhouette\" and "
                  "\"coarse\" (the others draw limit normals per vertex)");
   }
-  if (choice.method == Method::Uniform && p.engine != Engine::OpenSubdiv) {
+  if (choice.method == Method::Uniform &&
+      (p.engine == Engine::Masks || p.engine == Engine::Factored)) {
     std::string whyNot = rules::unsupportedReason(
         choice.mesh, p.engine == Engine::Masks ? rules::Method::Masks : rules::Method::Factored);
     if (!whyNot.empty()) {

@@ -25,6 +25,14 @@
 
 namespace limn::render::pipeline {
 
+// Whether a method (and the reference) evaluates the Bfr limit surface: all but uniform
+// refinement, which refines the cage itself, without a reference. Where it does, the pipeline
+// prepares the surface up front so that surfaceMs times it; elsewhere the surface builds itself
+// on first use, if any.
+inline bool evaluatesLimitSurface(Method method, bool reference) {
+  return reference || method != Method::Uniform;
+}
+
 // One method as a request chose it; the mesh is the client's (the cage overlay draws it).
 struct MethodChoice {
   const mesh::ControlMesh& mesh;

@@ -37,15 +37,17 @@ enum class Method { Coarse, Uniform, Adaptive, Limit, Silhouette, Patches };
 
 // Who refines for method "uniform": OpenSubdiv's Far, or limn's own rules (render/rules) by
 // masks or, for Catmull-Clark, in factored form.
-enum class Engine { OpenSubdiv, Masks, Factored };
+// Who refines a uniform mesh (tessellate.h's UniformEngine): Auto takes limn's quad path where
+// limn's rules take the mesh and OpenSubdiv elsewhere.
+enum class Engine { Auto, OpenSubdiv, Masks, Factored };
 
 enum class PatchTessellator { Cpu, Gpu };
 
 struct MethodParams {
-  int level = 3;                       // uniform
-  Engine engine = Engine::OpenSubdiv;  // uniform
-  bool pushToLimit = false;            // uniform: move every refined vertex to its limit position
-  double dicingRate = 1.0;             // adaptive, patches: target edge length in pixels
+  int level = 3;                 // uniform
+  Engine engine = Engine::Auto;  // uniform
+  bool pushToLimit = false;      // uniform: move every refined vertex to its limit position
+  double dicingRate = 1.0;       // adaptive, patches: target edge length in pixels
   int isolation = patches::kDefaultIsolation;  // patches: Far's adaptive isolation level
   bool cullPatches = true;  // patches: leave out patches outside the view or facing away
   // patches: who dices the patches, the CPU (welded, shared edge vertices) or the GPU's

@@ -72,6 +72,7 @@ Approximation approximate(const RenderJob& job, const JobLimits& limits,
   mesh::validateMesh(job.mesh, limits.mesh);
   cancel.check();
   const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
+  if (evaluatesLimitSurface(job.method, false)) surface.prepare(cancel);
   Approximation out{.mesh = {},
                     .camera = resolveCamera(job.camera, surface.bounds()),
                     .stats = {},
@@ -124,6 +125,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   if (!job.frames.empty()) return runFrames(job, limits, context, cancel);
 
   const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
+  if (evaluatesLimitSurface(job.method, job.reference)) surface.prepare(cancel);
   Camera camera = resolveCamera(job.camera, surface.bounds());
   RenderResult result{.images = {},
                       .referenceImages = {},

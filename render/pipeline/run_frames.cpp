@@ -61,6 +61,7 @@ RenderResult runFrames(const RenderJob& job, const JobLimits& limits, RenderCont
   Stopwatch clock, total;
   checkFrames(job, limits);
   const subdiv::LimitSurface surface(job.mesh, cancel, job.displacement);
+  if (evaluatesLimitSurface(job.method, job.reference)) surface.prepare(cancel);
   RenderResult result{.images = {},
                       .referenceImages = {},
                       .metrics = {},

@@ -18,6 +18,7 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
     try {
       out.presubdivided =
           std::make_unique<subdiv::LimitSurface>(silhouette::refineOnce(mesh), cancel);
+      out.presubdivided->prepare(cancel);
       out.presubdivisionLevels = 1;
       while (params.presubdivide == Presubdivide::Auto &&
              out.presubdivisionLevels < silhouette::kMaxPresubdivisionLevels &&
@@ -26,6 +27,7 @@ SilhouetteBuild buildSilhouette(const subdiv::LimitSurface& surface, const Camer
                  silhouette::kMaxChordDeviationPx) {
         out.presubdivided = std::make_unique<subdiv::LimitSurface>(
             silhouette::refineOnce(out.presubdivided->mesh()), cancel);
+        out.presubdivided->prepare(cancel);
         ++out.presubdivisionLevels;
       }
     } catch (const InputError& e) {

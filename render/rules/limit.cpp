@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "render/core/parallel.h"
+#include "render/rules/ring_limit.h"
 #include "render/rules/sharpness.h"
 #include "render/rules/steps.h"
 #include "render/rules/weights.h"
@@ -13,26 +14,6 @@ namespace limn::render::rules {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-struct Tangents {
-  Vec3 t1{0, 0, 0}, t2{0, 0, 0};
-};
-
-Vec3 unitCross(const Tangents& t) { return normalize(cross(t.t1, t.t2)); }
-
-// The weights of the interior tangents at valence n, computed once per valence.
-struct SmoothWeights {
-  std::vector<double> cosines, sines;  // cos(2 pi i / n), sin(2 pi i / n)
-  double faceScale = 0;                // Catmull-Clark: 1 / (4 lambda - 1)
-};
-
-// One side of a vertex: the ends of its edges E[0..m] and, for Catmull-Clark, the corners
-// diagonal to the vertex in its faces F[0..m-1] (face i between edges i and i+1), in
-// counter-clockwise order. Used for the two sides of a crease and the whole of a boundary.
-struct Side {
-  Vec3 v;
-  std::vector<Vec3> E, F;
-};
 
 // One side of a crease (or the whole of a boundary vertex): E[0] and E[m] are the crease.
 Tangents creaseTangents(mesh::Scheme scheme, const Side& s) {
@@ -78,151 +59,160 @@ Tangents creaseTangents(mesh::Scheme scheme, const Side& s) {
   return t;
 }
 
-// The limit of every vertex of one level, one vertex at a time, with scratch buffers and
-// per-valence weights kept between vertices.
+}  // namespace
+
+RingLimit::RingLimit(mesh::Scheme scheme) : scheme_(scheme) {}
+
+void RingLimit::evaluate(Rule rule) {
+  const int faces = faceCount();
+  position = v;
+  tangents = {};
+  faceNormals.assign(faces, Vec3{0, 0, 0});
+  if (faces == 0) return;
+  switch (rule) {
+    case Rule::Corner:
+      cornerSides();
+      break;
+    case Rule::Crease:
+      creaseSides();
+      break;
+    case Rule::Smooth:
+    case Rule::Dart:
+      smooth();
+      break;
+  }
+}
+
+// Each face's own corner plane: the corner rule's tangents (and valence-2 Catmull-Clark).
+void RingLimit::cornerSides() {
+  const int faces = faceCount();
+  for (int i = 0; i < faces; ++i) {
+    faceNormals[i] = unitCross({edgeEnd(i) - v, edgeEnd(i + 1) - v});
+  }
+  const double scale = scheme_ == mesh::Scheme::Loop ? 3.0 : 1.0;  // OpenSubdiv's scales
+  tangents = {scale * (edgeEnd(0) - v), scale * (edgeEnd(1) - v)};
+}
+
+void RingLimit::creaseSides() {
+  const int faces = faceCount();
+  int sharpAt[2] = {-1, -1};
+  for (int i = 0, found = 0; i < static_cast<int>(E.size()) && found < 2; ++i) {
+    if (sharp[i]) sharpAt[found++] = i;
+  }
+  position = (4.0 * v + E[sharpAt[0]] + E[sharpAt[1]]) / 6.0;
+  // The sides: from each sharp edge counter-clockwise to the next (a boundary vertex has one).
+  const int sides = boundary ? 1 : 2;
+  for (int s = 0; s < sides; ++s) {
+    const int first = sharpAt[s], last = s == 0 ? sharpAt[1] : sharpAt[0] + faces;
+    side_.v = v;
+    side_.E.clear();
+    side_.F.clear();
+    for (int i = first; i <= last; ++i) side_.E.push_back(edgeEnd(i));
+    for (int i = first; i < last; ++i) side_.F.push_back(F[i % faces]);
+    const Tangents sideTangents = creaseTangents(scheme_, side_);
+    const Vec3 normal = unitCross(sideTangents);
+    for (int i = first; i < last; ++i) faceNormals[i % faces] = normal;
+    // OpenSubdiv's convention: the side counter-clockwise from the first sharp edge.
+    if (s == 0) tangents = sideTangents;
+  }
+}
+
+// Smooth and dart: the interior eigenvectors.
+void RingLimit::smooth() {
+  const int n = faceCount();
+  Vec3 edgeSum{0, 0, 0}, faceSum{0, 0, 0};
+  for (int i = 0; i < n; ++i) edgeSum += E[i];
+  Tangents t;
+  const SmoothWeights& w = weights(n);
+  if (scheme_ == mesh::Scheme::Loop) {
+    const double chi = n == 6 ? 1.0 / 12.0 : loopLimitWeight(n);
+    position = (1.0 - n * chi) * v + chi * edgeSum;
+    for (int i = 0; i < n; ++i) {
+      t.t1 += w.cosines[i] * E[i];
+      t.t2 += w.sines[i] * E[i];
+    }
+  } else {
+    if (n == 2) return cornerSides();  // OpenSubdiv's choice at an interior valence 2
+    for (int i = 0; i < n; ++i) faceSum += F[i];
+    position = catmullClarkLimitVertexWeight(n) * v + catmullClarkLimitEdgeWeight(n) * edgeSum +
+               catmullClarkLimitFaceWeight(n) * faceSum;
+    // Edge weights 4 cos(i theta), face weights (cos(i theta) + cos((i+1) theta)) /
+    // (4 lambda - 1), lambda the subdominant eigenvalue; the second tangent is the first
+    // rotated by one edge.
+    const std::vector<double>& c = w.cosines;
+    for (int i = 0; i < n; ++i) {
+      const int prev = (i + n - 1) % n, next = (i + 1) % n;
+      t.t1 += 4.0 * c[i] * E[i] + w.faceScale * (c[i] + c[next]) * F[i];
+      t.t2 += 4.0 * c[prev] * E[i] + w.faceScale * (c[prev] + c[i]) * F[i];
+    }
+  }
+  tangents = t;
+  faceNormals.assign(n, unitCross(t));
+}
+
+const SmoothWeights& RingLimit::weights(int n) {
+  if (static_cast<int>(weights_.size()) <= n) weights_.resize(n + 1);
+  SmoothWeights& w = weights_[n];
+  if (w.cosines.empty()) {
+    const double theta = 2.0 * kPi / n;
+    for (int i = 0; i < n; ++i) {
+      w.cosines.push_back(std::cos(i * theta));
+      w.sines.push_back(std::sin(i * theta));
+    }
+    const double lambda =
+        5.0 / 16.0 +
+        (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
+    w.faceScale = 1.0 / (4.0 * lambda - 1.0);
+  }
+  return w;
+}
+
+namespace {
+
+// The limit of every vertex of one level, one vertex at a time: its ordered ring read from the
+// topology into a RingLimit (scratch buffers and per-valence weights kept between vertices).
 class LimitMasks {
  public:
   LimitMasks(const Topology& t, const std::vector<Vec3>& points)
-      : t_(t), P_(points), scheme_(t.options.scheme) {}
+      : t_(t), P_(points), ring_(t.options.scheme) {}
 
   void evaluate(int v, Limit& out, bool cornerNormals) {
-    orderedRing(t_, v, ring_);
-    const int faces = static_cast<int>(ring_.faces.size());
-    const int edges = static_cast<int>(ring_.edges.size());
-    Tangents tangents;
-    Vec3 position = P_[v];
-    faceNormals_.assign(faces, Vec3{0, 0, 0});
-    if (faces > 0) {
-      E_.resize(edges);
-      for (int i = 0; i < edges; ++i) E_[i] = P_[t_.otherVertex(ring_.edges[i], v)];
-      F_.resize(faces);
-      if (scheme_ == mesh::Scheme::CatmullClark) {
-        for (int i = 0; i < faces; ++i) {
-          std::span<const int> fv = t_.faceVerts(ring_.faces[i]);
-          F_[i] = P_[fv[(ring_.corners[i] + 2) % fv.size()]];
-        }
-      }
-      switch (currentRule(t_, v)) {
-        case Rule::Corner:
-          tangents = cornerSides(v);
-          break;
-        case Rule::Crease:
-          tangents = creaseSides(v, position);
-          break;
-        case Rule::Smooth:
-        case Rule::Dart:
-          tangents = smooth(v, position);
-          break;
+    orderedRing(t_, v, topologyRing_);
+    const int faces = static_cast<int>(topologyRing_.faces.size());
+    const int edges = static_cast<int>(topologyRing_.edges.size());
+    ring_.v = P_[v];
+    ring_.boundary = topologyRing_.boundary;
+    ring_.E.resize(edges);
+    ring_.sharp.resize(edges);
+    for (int i = 0; i < edges; ++i) {
+      const int e = topologyRing_.edges[i];
+      ring_.E[i] = P_[t_.otherVertex(e, v)];
+      ring_.sharp[i] = isSharp(t_.edgeSharpness[e]);
+    }
+    ring_.F.resize(faces);
+    if (t_.options.scheme == mesh::Scheme::CatmullClark) {
+      for (int i = 0; i < faces; ++i) {
+        std::span<const int> fv = t_.faceVerts(topologyRing_.faces[i]);
+        ring_.F[i] = P_[fv[(topologyRing_.corners[i] + 2) % fv.size()]];
       }
     }
-    out.positions[v] = position;
-    out.tangent1[v] = tangents.t1;
-    out.tangent2[v] = tangents.t2;
-    out.normals[v] = unitCross(tangents);
+    ring_.evaluate(currentRule(t_, v));
+    out.positions[v] = ring_.position;
+    out.tangent1[v] = ring_.tangents.t1;
+    out.tangent2[v] = ring_.tangents.t2;
+    out.normals[v] = unitCross(ring_.tangents);
     if (!cornerNormals) return;
     for (int i = 0; i < faces; ++i) {
-      out.cornerNormals[t_.faceOffsets[ring_.faces[i]] + ring_.corners[i]] = faceNormals_[i];
+      out.cornerNormals[t_.faceOffsets[topologyRing_.faces[i]] + topologyRing_.corners[i]] =
+          ring_.faceNormals[i];
     }
   }
 
  private:
-  // E[i] on a whole ring, where E[faces] is E[0] again.
-  const Vec3& edgeEnd(int i) const { return E_[i % E_.size()]; }
-
-  // Each face's own corner plane: the corner rule's tangents (and valence-2 Catmull-Clark).
-  Tangents cornerSides(int v) {
-    const int faces = static_cast<int>(ring_.faces.size());
-    for (int i = 0; i < faces; ++i) {
-      faceNormals_[i] = unitCross({edgeEnd(i) - P_[v], edgeEnd(i + 1) - P_[v]});
-    }
-    const double scale = scheme_ == mesh::Scheme::Loop ? 3.0 : 1.0;  // OpenSubdiv's scales
-    return {scale * (edgeEnd(0) - P_[v]), scale * (edgeEnd(1) - P_[v])};
-  }
-
-  Tangents creaseSides(int v, Vec3& position) {
-    const int faces = static_cast<int>(ring_.faces.size());
-    int sharp[2] = {-1, -1};
-    for (int i = 0, found = 0; i < static_cast<int>(ring_.edges.size()) && found < 2; ++i) {
-      if (isSharp(t_.edgeSharpness[ring_.edges[i]])) sharp[found++] = i;
-    }
-    position = (4.0 * P_[v] + E_[sharp[0]] + E_[sharp[1]]) / 6.0;
-    // The sides: from each sharp edge counter-clockwise to the next (a boundary vertex has one).
-    Tangents own;
-    const int sides = ring_.boundary ? 1 : 2;
-    for (int s = 0; s < sides; ++s) {
-      const int first = sharp[s], last = s == 0 ? sharp[1] : sharp[0] + faces;
-      side_.v = P_[v];
-      side_.E.clear();
-      side_.F.clear();
-      for (int i = first; i <= last; ++i) side_.E.push_back(edgeEnd(i));
-      for (int i = first; i < last; ++i) side_.F.push_back(F_[i % faces]);
-      const Tangents tangents = creaseTangents(scheme_, side_);
-      const Vec3 normal = unitCross(tangents);
-      for (int i = first; i < last; ++i) faceNormals_[i % faces] = normal;
-      // OpenSubdiv's convention: the side counter-clockwise from the first sharp edge.
-      if (s == 0) own = tangents;
-    }
-    return own;
-  }
-
-  // Smooth and dart: the interior eigenvectors.
-  Tangents smooth(int v, Vec3& position) {
-    const int n = static_cast<int>(ring_.faces.size());
-    Vec3 edgeSum{0, 0, 0}, faceSum{0, 0, 0};
-    for (int i = 0; i < n; ++i) edgeSum += E_[i];
-    Tangents t;
-    const SmoothWeights& w = weights(n);
-    if (scheme_ == mesh::Scheme::Loop) {
-      const double chi = n == 6 ? 1.0 / 12.0 : loopLimitWeight(n);
-      position = (1.0 - n * chi) * P_[v] + chi * edgeSum;
-      for (int i = 0; i < n; ++i) {
-        t.t1 += w.cosines[i] * E_[i];
-        t.t2 += w.sines[i] * E_[i];
-      }
-    } else {
-      if (n == 2) return cornerSides(v);  // OpenSubdiv's choice at an interior valence 2
-      for (int i = 0; i < n; ++i) faceSum += F_[i];
-      position = catmullClarkLimitVertexWeight(n) * P_[v] +
-                 catmullClarkLimitEdgeWeight(n) * edgeSum +
-                 catmullClarkLimitFaceWeight(n) * faceSum;
-      // Edge weights 4 cos(i theta), face weights (cos(i theta) + cos((i+1) theta)) /
-      // (4 lambda - 1), lambda the subdominant eigenvalue; the second tangent is the first
-      // rotated by one edge.
-      const std::vector<double>& c = w.cosines;
-      for (int i = 0; i < n; ++i) {
-        const int prev = (i + n - 1) % n, next = (i + 1) % n;
-        t.t1 += 4.0 * c[i] * E_[i] + w.faceScale * (c[i] + c[next]) * F_[i];
-        t.t2 += 4.0 * c[prev] * E_[i] + w.faceScale * (c[prev] + c[i]) * F_[i];
-      }
-    }
-    faceNormals_.assign(n, unitCross(t));
-    return t;
-  }
-
-  const SmoothWeights& weights(int n) {
-    if (static_cast<int>(weights_.size()) <= n) weights_.resize(n + 1);
-    SmoothWeights& w = weights_[n];
-    if (w.cosines.empty()) {
-      const double theta = 2.0 * kPi / n;
-      for (int i = 0; i < n; ++i) {
-        w.cosines.push_back(std::cos(i * theta));
-        w.sines.push_back(std::sin(i * theta));
-      }
-      const double lambda =
-          5.0 / 16.0 +
-          (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
-      w.faceScale = 1.0 / (4.0 * lambda - 1.0);
-    }
-    return w;
-  }
-
   const Topology& t_;
   const std::vector<Vec3>& P_;
-  const mesh::Scheme scheme_;
-  VertexRing ring_;
-  std::vector<Vec3> E_, F_, faceNormals_;
-  Side side_;
-  std::vector<SmoothWeights> weights_;
+  VertexRing topologyRing_;
+  RingLimit ring_;
 };
 
 bool hasNonQuad(const Topology& t) {

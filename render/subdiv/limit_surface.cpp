@@ -120,9 +120,10 @@ std::unique_ptr<Far::TopologyRefiner> createTopologyRefiner(const mesh::ControlM
 }
 
 LimitSurface::LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoOnFarPatches)
-    : mesh_(std::move(mesh)), bounds_(mesh_.bounds()), refiner_(createTopologyRefiner(mesh_)) {
-  build(alsoOnFarPatches, CancelToken());
-}
+    : mesh_(std::move(mesh)),
+      bounds_(mesh_.bounds()),
+      refiner_(createTopologyRefiner(mesh_)),
+      alsoOnFarPatches_(alsoOnFarPatches) {}
 
 LimitSurface::LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel)
     : LimitSurface(std::move(mesh), cancel, DisplacementSpec{}) {}
@@ -134,17 +135,37 @@ LimitSurface::LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel,
       displacementSpec_(displacement),
       displacement_(displacement, bounds_),
       refiner_(createTopologyRefiner(mesh_)) {
+  cancel.check();
   const double reach = displacement_.reach();
   if (reach > 0 && !bounds_.empty()) {
     bounds_.extend(bounds_.lo - Vec3{reach, reach, reach});
     bounds_.extend(bounds_.hi + Vec3{reach, reach, reach});
   }
-  build({}, cancel);
 }
 
-void LimitSurface::build(const std::vector<int>& alsoOnFarPatches, const CancelToken& cancel) {
+void LimitSurface::prepare() const {
+  static const CancelToken never;
+  prepare(never);
+}
+
+void LimitSurface::prepare(const CancelToken& cancel) const {
+  if (prepared_.load(std::memory_order_acquire)) return;
+  std::lock_guard lock(prepareMutex_);  // other threads wait here for the one building
+  if (prepared_.load(std::memory_order_relaxed) || building_) return;
+  building_ = true;
+  try {
+    build(cancel);
+  } catch (...) {
+    building_ = false;
+    throw;
+  }
+  building_ = false;
+  prepared_.store(true, std::memory_order_release);
+}
+
+void LimitSurface::build(const CancelToken& cancel) const {
   std::vector<int> farPatchFaces = facesBfrCannotEvaluate();
-  farPatchFaces.insert(farPatchFaces.end(), alsoOnFarPatches.begin(), alsoOnFarPatches.end());
+  farPatchFaces.insert(farPatchFaces.end(), alsoOnFarPatches_.begin(), alsoOnFarPatches_.end());
   std::sort(farPatchFaces.begin(), farPatchFaces.end());
   farPatchFaces.erase(std::unique(farPatchFaces.begin(), farPatchFaces.end()), farPatchFaces.end());
   cancel.check();
@@ -190,7 +211,7 @@ std::vector<char> facesAtSpikes(const Far::TopologyLevel& base) {
 }
 
 void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
-                                     const CancelToken& cancel) {
+                                     const CancelToken& cancel) const {
   if (!farPatchFaces.empty()) {
     // Far refines its refiner adaptively; refiner_ is shared (baseLevel()), so it gets its own.
     farPatches_ = std::make_unique<FarPatchSurface>(createRefiner(), farPatchFaces, mesh_.points);
@@ -212,6 +233,7 @@ void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
   const Bfr::Surface<double>::PointDescriptor xyz(3);
 
   faces_.assign(mesh_.faceCount(), FaceData{});
+  surfaces_.clear();  // a build cancelled before may have left some
   surfaces_.reserve(mesh_.faceCount());
   for (int f = 0; f < mesh_.faceCount(); ++f) {
     if (f % kFacesBetweenChecks == 0) cancel.check();
@@ -232,6 +254,7 @@ void LimitSurface::buildFaceSurfaces(const std::vector<int>& farPatchFaces,
 }
 
 Bfr::Parameterization LimitSurface::parameterization(int face) const {
+  prepare();
   const int surface = faces_[face].surfaceIndex;
   if (surface >= 0) return surfaces_[surface].surface.GetParameterization();
   return Bfr::Parameterization(schemeType(mesh_.scheme), mesh_.faceVertexCounts[face]);
@@ -306,6 +329,7 @@ void LimitSurface::evaluateDerivatives(int face, double u, double v, Vec3& posit
 }
 
 LimitSample LimitSurface::evaluate(int face, double u, double v) const {
+  prepare();
   LimitSample s;
   evaluateDerivatives(face, u, v, s.position, s.du, s.dv);
   Vec3 n = cross(s.du, s.dv);
@@ -323,6 +347,7 @@ LimitSample LimitSurface::evaluate(int face, double u, double v) const {
 }
 
 Vec3 LimitSurface::position(int face, double u, double v) const {
+  prepare();
   if (faces_[face].onFarPatches || displacement_.enabled()) {
     Vec3 p, du, dv;
     evaluateDerivatives(face, u, v, p, du, dv);
@@ -336,7 +361,7 @@ Vec3 LimitSurface::position(int face, double u, double v) const {
   return {p[0], p[1], p[2]};
 }
 
-void LimitSurface::computeControlLimits(const CancelToken& cancel) {
+void LimitSurface::computeControlLimits(const CancelToken& cancel) const {
   controlLimitPositions_ = mesh_.points;
   controlLimitNormals_.assign(mesh_.points.size(), Vec3{0, 0, 0});
   std::vector<bool> done(mesh_.points.size(), false);

@@ -1,8 +1,10 @@
 // LimitSurface: the smooth limit surface of a ControlMesh, through OpenSubdiv.
 //
 // Built once per request from a validated ControlMesh: Far holds the topology (with creases,
-// corners, holes, boundary and crease rules), Bfr gives one Surface per face. Every face's
-// surface and patch points are prepared at construction, so evaluate() is const and safe to
+// corners, holes, boundary and crease rules), Bfr gives one Surface per face. The Far topology
+// is made at construction; the per-face Bfr surfaces (most of the cost) by prepare(), which
+// every accessor that needs them calls first, so a request that never evaluates the surface
+// (uniform refinement without a reference) never pays for them. evaluate() is const and safe to
 // call from many threads at once.
 //
 // Faces around an interior vertex of valence 2, whose Bfr patches OpenSubdiv 3.5.0 cannot build
@@ -18,7 +20,9 @@
 #include <opensubdiv/bfr/parameterization.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
+#include <atomic>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "render/core/cancel.h"
@@ -64,9 +68,8 @@ class LimitSurface {
   // `alsoOnFarPatches` (for tests): faces to evaluate through Far's patch table although Bfr
   // could, to compare the two.
   explicit LimitSurface(mesh::ControlMesh mesh, const std::vector<int>& alsoOnFarPatches = {});
-  // The same for a request: `cancel` is checked while the per-face surfaces are built (every
-  // few faces; a face around a vertex of valence n costs about n^2), and Cancelled thrown when
-  // it expires.
+  // The same for a request: Cancelled is thrown when `cancel` has expired already (the per-face
+  // surfaces check it while prepare(cancel) builds them).
   LimitSurface(mesh::ControlMesh mesh, const CancelToken& cancel);
   // The limit surface displaced along its normals (displacement.h): every evaluation below,
   // bounds() and the control limits are then of the displaced surface.
@@ -90,11 +93,23 @@ class LimitSurface {
   // The base level's topology (edges, faces, vertices), read-only and shared.
   const OpenSubdiv::Far::TopologyLevel& baseLevel() const;
 
+  // Builds the per-face surfaces now, checking `cancel` every few faces (a face around a vertex
+  // of valence n costs about n^2) and throwing Cancelled when it expires; a request does this
+  // up front when it will evaluate the surface, which also times the build. Otherwise the first
+  // accessor that needs them builds them, uncancellable.
+  void prepare(const CancelToken& cancel) const;
+
   // ---- Per-face limit surfaces ----
   // False for holes and for faces OpenSubdiv gives no limit surface.
-  bool hasLimit(int face) const { return faces_[face].valid; }
+  bool hasLimit(int face) const {
+    prepare();
+    return faces_[face].valid;
+  }
   // True when the face is evaluated through Far's patch table rather than Bfr.
-  bool onFarPatches(int face) const { return faces_[face].onFarPatches; }
+  bool onFarPatches(int face) const {
+    prepare();
+    return faces_[face].onFarPatches;
+  }
   OpenSubdiv::Bfr::Parameterization parameterization(int face) const;
   // Parametric coordinates of the face's k-th corner.
   Vec2 cornerUV(int face, int corner) const;
@@ -107,15 +122,21 @@ class LimitSurface {
 
   // Limit positions and normals of the control vertices (vertex-sharing faces agree), for
   // shading and measuring the cage. Vertices of holes only get the value of any non-hole face.
-  const std::vector<Vec3>& controlLimitPositions() const { return controlLimitPositions_; }
-  const std::vector<Vec3>& controlLimitNormals() const { return controlLimitNormals_; }
+  const std::vector<Vec3>& controlLimitPositions() const {
+    prepare();
+    return controlLimitPositions_;
+  }
+  const std::vector<Vec3>& controlLimitNormals() const {
+    prepare();
+    return controlLimitNormals_;
+  }
 
  private:
   struct FaceSurface;
   std::vector<int> facesBfrCannotEvaluate() const;
-  void build(const std::vector<int>& alsoOnFarPatches, const CancelToken& cancel);
-  void buildFaceSurfaces(const std::vector<int>& farPatchFaces, const CancelToken& cancel);
-  void computeControlLimits(const CancelToken& cancel);
+  void build(const CancelToken& cancel) const;
+  void buildFaceSurfaces(const std::vector<int>& farPatchFaces, const CancelToken& cancel) const;
+  void computeControlLimits(const CancelToken& cancel) const;
   void evaluateDerivatives(int face, double u, double v, Vec3& position, Vec3& du, Vec3& dv) const;
   void evaluateUndisplaced(int face, double u, double v, Vec3& position, Vec3& du, Vec3& dv) const;
   SurfaceJet evaluateJet(int face, double u, double v) const;
@@ -130,11 +151,17 @@ class LimitSurface {
     bool onFarPatches = false;
     int surfaceIndex = -1;  // into surfaces_, for faces on Bfr
   };
-  std::vector<FaceData> faces_;
-  std::vector<FaceSurface> surfaces_;
-  std::unique_ptr<FarPatchSurface> farPatches_;  // only when some face needs it
-  std::vector<Vec3> controlLimitPositions_;
-  std::vector<Vec3> controlLimitNormals_;
+  void prepare() const;
+  // Made by prepare(), once; `building_` lets the build itself read what it has made so far.
+  std::vector<int> alsoOnFarPatches_;
+  mutable std::atomic<bool> prepared_{false};
+  mutable std::recursive_mutex prepareMutex_;
+  mutable bool building_ = false;
+  mutable std::vector<FaceData> faces_;
+  mutable std::vector<FaceSurface> surfaces_;
+  mutable std::unique_ptr<FarPatchSurface> farPatches_;  // only when some face needs it
+  mutable std::vector<Vec3> controlLimitPositions_;
+  mutable std::vector<Vec3> controlLimitNormals_;
 };
 
 }  // namespace limn::render::subdiv

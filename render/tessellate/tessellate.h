@@ -20,16 +20,24 @@ TriangleMesh tessellateCoarse(const subdiv::LimitSurface& surface);
 
 // Which implementation of the subdivision rules refines a uniform mesh: OpenSubdiv's Far, or
 // limn's own (render/rules) by masks or, for Catmull-Clark, in factored form. All three give
-// the same vertices in the same order where their rules agree (docs/engine.md).
-enum class UniformEngine { OpenSubdiv, Masks, Factored };
+// the same vertices in the same order where their rules agree (docs/engine.md). Auto, the
+// fastest that takes the mesh: the masks for manifold Catmull-Clark meshes (their levels run as
+// quads on halfedges, in parallel), OpenSubdiv for Loop, bilinear and non-manifold meshes.
+enum class UniformEngine { Auto, OpenSubdiv, Masks, Factored };
 
 struct UniformOptions {
   int level = 3;
-  UniformEngine engine = UniformEngine::OpenSubdiv;
+  UniformEngine engine = UniformEngine::Auto;
   // false: vertices stay where refinement put them (limitPositions holds their limit);
   // true: every vertex is moved to its limit position. Normals are the limit normals either way.
   bool pushToLimit = false;
   size_t maxTriangles = 8'000'000;
+  // Optional: where the time went (benchmarks).
+  struct Stages {
+    double refineMs = 0;  // topology and refined points of every level
+    double limitMs = 0;   // limit positions and normals of the last level
+    double meshMs = 0;    // the triangles, lines and float buffers the rasteriser takes
+  }* stages = nullptr;
 };
 
 // Throws InputError(LimitExceeded, "maxTriangles") if the result would exceed maxTriangles,

@@ -6,12 +6,15 @@
 #include <opensubdiv/far/topologyRefiner.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "render/core/error.h"
 #include "render/core/parallel.h"
 #include "render/rules/limit.h"
+#include "render/rules/quad_level.h"
 #include "render/rules/refine.h"
 #include "render/subdiv/far_limit.h"
 #include "render/subdiv/far_point.h"
@@ -30,9 +33,25 @@ struct Refined {
   std::vector<int> faceOffsets{0}, faceVertices;
   std::vector<uint8_t> hole;
   std::vector<std::array<int, 2>> edgeVertices;
+  // Which faces lie around each edge and vertex (offset + index arrays).
   std::vector<int> edgeFaceOffsets, edgeFaces;
   std::vector<int> vertexFaceOffsets, vertexFaces;
   int faceCount() const { return static_cast<int>(faceOffsets.size()) - 1; }
+};
+
+// Milliseconds since `start`, added to *stage when timing is asked for.
+class StageTimer {
+ public:
+  explicit StageTimer(UniformOptions::Stages* stages) : stages_(stages) {}
+  void lap(double UniformOptions::Stages::*stage) {
+    const auto now = std::chrono::steady_clock::now();
+    if (stages_) stages_->*stage += std::chrono::duration<double, std::milli>(now - start_).count();
+    start_ = now;
+  }
+
+ private:
+  UniformOptions::Stages* stages_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
 // Loops over this many elements per task: enough to amortise a task, few enough to balance.
@@ -54,7 +73,7 @@ size_t predictedTriangles(const mesh::ControlMesh& cage, int level) {
   return static_cast<size_t>(count * std::pow(4.0, level));
 }
 
-Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
+Refined refineWithFar(const subdiv::LimitSurface& surface, int level, StageTimer& timer) {
   std::unique_ptr<Far::TopologyRefiner> refiner = surface.createRefiner();
   Far::TopologyRefiner::UniformOptions options(level);
   options.fullTopologyInLastLevel = true;
@@ -75,6 +94,7 @@ Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
   }
   const Far::TopologyLevel& last = refiner->GetLevel(level);
   const int vertexCount = last.GetNumVertices();
+  timer.lap(&UniformOptions::Stages::refineMs);
   std::vector<subdiv::FarPoint> limit, du, dv;
   subdiv::limitOfLastLevel(*refiner, src, limit, du, dv);  // not PrimvarRefiner::Limit: far_limit.h
 
@@ -89,6 +109,7 @@ Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
       out.normals[v] = cross(du[v].p, dv[v].p);
     }
   });
+  timer.lap(&UniformOptions::Stages::limitMs);
   // Far's accessors hand out arrays of its own; copy them into flat offset + index arrays.
   const auto flatten = [](int count, auto arrayOf, std::vector<int>& offsets,
                           std::vector<int>& values) {
@@ -121,9 +142,11 @@ Refined refineWithFar(const subdiv::LimitSurface& surface, int level) {
   return out;
 }
 
-Refined refineWithRules(const mesh::ControlMesh& cage, int level, rules::Method method) {
-  rules::Level refined = rules::refineUniform(cage, level, method);
+// A level of limn's rules (refined on its Topology) with its limit.
+Refined fromRules(rules::Level refined, const mesh::ControlMesh& cage, int level,
+                  StageTimer& timer) {
   rules::Limit limit = rules::limitOf(refined, /*cornerNormals=*/false);
+  timer.lap(&UniformOptions::Stages::limitMs);
   Refined out;
   out.points = std::move(refined.points);
   out.limit = std::move(limit.positions);
@@ -221,6 +244,86 @@ TriangleMesh assemble(const Refined& r, bool pushToLimit) {
   return out;
 }
 
+// Indices [0, count) that `keep` keeps, in order: where each kept element goes in a compacted
+// array (the kept ones' rank), and how many are kept.
+template <typename Keep>
+std::vector<uint32_t> ranksOf(size_t count, Keep keep, size_t& kept) {
+  std::vector<uint32_t> rank(count);
+  kept = 0;
+  for (size_t i = 0; i < count; ++i) {
+    rank[i] = static_cast<uint32_t>(kept);
+    kept += keep(i) ? 1 : 0;
+  }
+  return rank;
+}
+
+// A level refined as quads (rules/quad_level.h), straight into the mesh the rasteriser takes:
+// the vertices in one pass over their rings, two triangles per quad that is not a hole, and
+// the edges of the quads drawn.
+TriangleMesh assembleQuads(const rules::QuadLevel& q, bool pushToLimit, StageTimer& timer) {
+  TriangleMesh out;
+  out.positions.resize(q.vertexCount);
+  out.limitPositions.resize(q.vertexCount);
+  out.normals.resize(q.vertexCount);
+  rules::drawnVertices(q, pushToLimit, out.positions.data(), out.limitPositions.data(),
+                       out.normals.data());
+  timer.lap(&UniformOptions::Stages::limitMs);
+
+  size_t drawnFaces = 0;
+  const std::vector<uint32_t> faceRank = ranksOf(
+      q.faceCount(), [&](size_t f) { return !q.faceHole[f]; }, drawnFaces);
+  out.indices.resize(6 * drawnFaces);
+  parallelFor(q.faceCount(), kGrain, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      if (q.faceHole[f]) continue;
+      const int* c = q.vert.data() + 4 * f;
+      uint32_t* t = out.indices.data() + 6 * size_t{faceRank[f]};
+      const uint32_t corner[4] = {static_cast<uint32_t>(c[0]), static_cast<uint32_t>(c[1]),
+                                  static_cast<uint32_t>(c[2]), static_cast<uint32_t>(c[3])};
+      t[0] = corner[0], t[1] = corner[1], t[2] = corner[2];
+      t[3] = corner[0], t[4] = corner[2], t[5] = corner[3];
+    }
+  });
+
+  const auto drawnEdge = [&](size_t e) {
+    const int first = q.edgeFirst[e], other = q.twin[first];
+    return !q.faceHole[rules::faceOfHalfedge(first)] ||
+           (other >= 0 && !q.faceHole[rules::faceOfHalfedge(other)]);
+  };
+  size_t drawnEdges = 0;
+  const std::vector<uint32_t> edgeRank = ranksOf(q.edgeCount(), drawnEdge, drawnEdges);
+  out.lines.resize(2 * drawnEdges);
+  parallelFor(q.edgeCount(), kGrain, [&](size_t begin, size_t end) {
+    for (size_t e = begin; e < end; ++e) {
+      if (!drawnEdge(e)) continue;
+      out.lines[2 * size_t{edgeRank[e]}] = static_cast<uint32_t>(q.edgeVertices[e][0]);
+      out.lines[2 * size_t{edgeRank[e]} + 1] = static_cast<uint32_t>(q.edgeVertices[e][1]);
+    }
+  });
+  timer.lap(&UniformOptions::Stages::meshMs);
+  return out;
+}
+
+// limn's own rules: the masks run their last levels as quads where the mesh allows
+// (rules::refineUniformFast), the factored method level by level on the Topology.
+TriangleMesh tessellateWithRules(const mesh::ControlMesh& cage, const UniformOptions& o,
+                                 rules::Method method) {
+  StageTimer timer(o.stages);
+  rules::Level level;
+  if (method == rules::Method::Masks) {
+    rules::FastRefinement fast = rules::refineUniformFast(cage, o.level);
+    timer.lap(&UniformOptions::Stages::refineMs);
+    if (fast.quads) return assembleQuads(*fast.quads, o.pushToLimit, timer);
+    level = std::move(fast.level);
+  } else {
+    level = rules::refineUniform(cage, o.level, method);
+    timer.lap(&UniformOptions::Stages::refineMs);
+  }
+  TriangleMesh mesh = assemble(fromRules(std::move(level), cage, o.level, timer), o.pushToLimit);
+  timer.lap(&UniformOptions::Stages::meshMs);
+  return mesh;
+}
+
 }  // namespace
 
 TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, const UniformOptions& o) {
@@ -231,25 +334,39 @@ TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, const Unifor
                          std::to_string(predicted) + " triangles: exceeds limit maxTriangles " +
                          std::to_string(o.maxTriangles));
   }
-  if (o.engine != UniformEngine::OpenSubdiv) {
+  const mesh::ControlMesh& cage = surface.mesh();
+  if (o.engine == UniformEngine::Masks || o.engine == UniformEngine::Factored) {
     rules::Method method =
         o.engine == UniformEngine::Masks ? rules::Method::Masks : rules::Method::Factored;
-    std::string whyNot = rules::unsupportedReason(surface.mesh(), method);
+    std::string whyNot = rules::unsupportedReason(cage, method);
     if (!whyNot.empty()) throw InputError(InputError::Kind::InvalidParameter, "engine", whyNot);
-    return assemble(refineWithRules(surface.mesh(), o.level, method), o.pushToLimit);
+    return tessellateWithRules(cage, o, method);
+  }
+  if (o.engine == UniformEngine::Auto && o.level > 0 && cage.scheme == mesh::Scheme::CatmullClark &&
+      rules::unsupportedReason(cage, rules::Method::Masks).empty()) {
+    try {
+      return tessellateWithRules(cage, o, rules::Method::Masks);
+    } catch (const InputError& e) {
+      // Not manifold: limn's rules refuse it before refining anything; OpenSubdiv takes it.
+      if (e.kind() != InputError::Kind::InvalidMesh) throw;
+    }
   }
   if (o.level == 0) {
     TriangleMesh coarse = tessellateCoarse(surface);
     if (o.pushToLimit) coarse.positions = coarse.limitPositions;
     return coarse;
   }
-  return assemble(refineWithFar(surface, o.level), o.pushToLimit);
+  StageTimer timer(o.stages);
+  TriangleMesh mesh = assemble(refineWithFar(surface, o.level, timer), o.pushToLimit);
+  timer.lap(&UniformOptions::Stages::meshMs);
+  return mesh;
 }
 
 TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, int level,
                                size_t maxTriangles) {
   UniformOptions options;
   options.level = level;
+  options.engine = UniformEngine::OpenSubdiv;
   options.maxTriangles = maxTriangles;
   return tessellateUniform(surface, options);
 }

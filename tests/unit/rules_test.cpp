@@ -18,6 +18,7 @@
 #include "api/obj_reader.h"
 #include "render/core/error.h"
 #include "render/rules/limit.h"
+#include "render/rules/quad_level.h"
 #include "render/rules/refine.h"
 #include "render/rules/weights.h"
 #include "render/subdiv/far_point.h"
@@ -195,6 +196,49 @@ TEST_P(EveryShape, MasksRefineAsOpenSubdivVertexForVertex) {
     RecordProperty("maxRelErrorLevel" + std::to_string(l),
                    sci(worst / shape.mesh.bounds().diagonal()));
   }
+}
+
+// ---- Quad levels (halfedges, parallel) = the Topology path = OpenSubdiv ----
+
+// Every level the quad path reaches: the same faces, points and limits as the Topology path
+// (which the tests above hold to OpenSubdiv), so the fast path is held to OpenSubdiv too.
+TEST_P(EveryShape, QuadLevelsRefineAsTheTopologyPath) {
+  const Shape& shape = GetParam();
+  std::string whyNot;
+  std::optional<Level> level = base(shape, whyNot);
+  if (!level) GTEST_SKIP() << shape.name << " skipped: " << whyNot;
+  if (shape.mesh.scheme != Scheme::CatmullClark) GTEST_SKIP() << "the quad path is Catmull-Clark's";
+  const double tolerance = 1e-9 * shape.mesh.bounds().diagonal();
+  int quadLevels = 0;
+  for (int l = 1; l <= kMaxLevel; ++l) {
+    *level = refine(*level, Method::Masks);
+    FastRefinement fast = refineUniformFast(shape.mesh, l);
+    if (!fast.quads) continue;
+    ++quadLevels;
+    const QuadLevel& q = *fast.quads;
+    ASSERT_EQ(q.vertexCount, level->topology.vertexCount) << "level " << l;
+    ASSERT_TRUE(std::equal(q.vert.begin(), q.vert.end(), level->topology.faceVertices.begin(),
+                           level->topology.faceVertices.end()))
+        << "level " << l;
+    ASSERT_TRUE(std::equal(q.edgeVertices.begin(), q.edgeVertices.end(),
+                           level->topology.edgeVertices.begin(),
+                           level->topology.edgeVertices.end()))
+        << "level " << l;
+    for (int f = 0; f < q.faceCount(); ++f) {
+      EXPECT_EQ(q.faceHole[f], level->topology.faceHole[f]) << "level " << l << " face " << f;
+    }
+    const Limit limit = limitOf(*level);
+    const QuadLimit quadLimit = limitOfQuads(q);
+    for (int v = 0; v < q.vertexCount; ++v) {
+      ASSERT_LE(length(q.points[v] - level->points[v]), tolerance) << "level " << l << " v " << v;
+      ASSERT_LE(length(quadLimit.positions[v] - limit.positions[v]), tolerance)
+          << "level " << l << " vertex " << v;
+      // The same ring start: the same side of a crease or corner, so the same normal.
+      ASSERT_LE(length(quadLimit.normals[v] - limit.normals[v]), 1e-9)
+          << "level " << l << " vertex " << v;
+    }
+  }
+  RecordProperty("quadLevels", quadLevels);
 }
 
 // ---- Limit masks = OpenSubdiv's PrimvarRefiner::Limit ----

@@ -40,6 +40,14 @@ TEST(LimitSurface, ExpiredTokenStopsTheBuild) {
   cancel.cancel();
   EXPECT_THROW(LimitSurface(testing::torus(40, 25, false), cancel), Cancelled);
   EXPECT_NO_THROW(LimitSurface(testing::torus(40, 25, false), CancelToken()));
+  // The per-face surfaces are built by prepare(), which stops when its token expires; a later
+  // accessor builds them whole.
+  CancelToken live;
+  const LimitSurface surface(testing::torus(40, 25, false), live);
+  live.cancel();
+  EXPECT_THROW(surface.prepare(live), Cancelled);
+  EXPECT_TRUE(surface.hasLimit(0));
+  EXPECT_NEAR(length(surface.evaluate(0, 0.5, 0.5).normal), 1.0, 1e-12);
 }
 
 TEST(LimitSurface, RegularCatmullClarkFaceIsTheBicubicBSpline) {

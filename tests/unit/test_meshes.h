@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -421,6 +422,64 @@ inline ControlMesh splitBipyramid(int n) {
     addFace(m, {next, k, n + 1});
   }
   return displaced(splitOnce(m));
+}
+
+// A creature-like closed-and-open Catmull-Clark cage of about 6 n^2 faces, standing in for the
+// character models users bring: a cube-sphere of n x n quads per side (eight valence-3 poles)
+// blown up into a bumpy, elongated body; an open mouth (a hole cut through, so a boundary
+// loop); a band of triangles next to quads; an infinitely sharp ridge and a semi-sharp one.
+inline ControlMesh creature(int n) {
+  ControlMesh m;
+  std::map<std::array<int, 3>, int> index;  // lattice point on the cube's surface -> vertex
+  auto vertex = [&](std::array<int, 3> c) {
+    auto [it, added] = index.try_emplace(c, static_cast<int>(m.points.size()));
+    if (added) {
+      Vec3 p{2.0 * c[0] / n - 1, 2.0 * c[1] / n - 1, 2.0 * c[2] / n - 1};
+      const double len = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+      p = p / len;
+      const double bump =
+          1 + 0.08 * std::sin(5 * p.x) * std::sin(4 * p.y) + 0.05 * std::cos(7 * p.z);
+      m.points.push_back({0.8 * bump * p.x, 1.4 * bump * p.y, 0.9 * bump * p.z});
+    }
+    return it->second;
+  };
+  // Each side: the axis it faces, its sign, and two in-plane axes whose cross product is its
+  // outward normal (so the quads run counter-clockwise seen from outside).
+  struct Side {
+    int axis, u, v;
+    bool high;
+  };
+  const Side sides[6] = {{0, 1, 2, true},  {0, 2, 1, false}, {1, 2, 0, true},
+                         {1, 0, 2, false}, {2, 0, 1, true},  {2, 1, 0, false}};
+  std::vector<std::array<int, 2>> ridge, semiRidge;
+  for (int s = 0; s < 6; ++s) {
+    const Side& side = sides[s];
+    auto at = [&](int i, int j) {
+      std::array<int, 3> c{};
+      c[side.axis] = side.high ? n : 0;
+      c[side.u] = i;
+      c[side.v] = j;
+      return vertex(c);
+    };
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const bool mouth = s == 4 && i >= n / 3 && i < 2 * n / 3 && j >= n / 5 && j < n / 3;
+        if (mouth) continue;
+        const int a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+        if (s == 2 && j >= n / 2 && j < n / 2 + n / 8) {  // the band of triangles
+          addFace(m, {a, b, c});
+          addFace(m, {a, c, d});
+        } else {
+          addFace(m, {a, b, c, d});
+        }
+        if (j == n / 2 && s == 1) ridge.push_back({a, b});
+        if (j == n / 2 && s == 0) semiRidge.push_back({a, b});
+      }
+    }
+  }
+  for (auto [a, b] : ridge) m.creases.push_back({a, b, 10.0f});
+  for (auto [a, b] : semiRidge) m.creases.push_back({a, b, 2.0f});
+  return m;
 }
 
 }  // namespace limn::testing
