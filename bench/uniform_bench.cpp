@@ -62,6 +62,8 @@ std::vector<NamedMesh> meshes() {
       {"pawn.obj (144 faces, semi-sharp)", example("pawn.obj", Scheme::CatmullClark)},
       {"torus_creased.obj", example("torus_creased.obj", Scheme::CatmullClark)},
       {"creature(8) (" + std::to_string(lowPoly.faceCount()) + " faces)", lowPoly},
+      {"creature(16) (" + std::to_string(testing::creature(16).faceCount()) + " faces)",
+       testing::creature(16)},
       {"creature(32) (" + std::to_string(testing::creature(32).faceCount()) + " faces)",
        testing::creature(32)},
       {"creature(56) (" + std::to_string(testing::creature(56).faceCount()) + " faces)",
@@ -144,9 +146,7 @@ int main(int argc, char** argv) {
       "mesh) | masks 1 thread ms | same | masks / Far positions | Mvert/s | vs 4x prev |\n");
   std::printf("|---|---:|---:|---:|---:|---|---:|:---:|---:|---:|---:|\n");
   for (const NamedMesh& named : meshes()) {
-    const auto surfaceStart = std::chrono::steady_clock::now();
     render::subdiv::LimitSurface surface(named.mesh);
-    std::fprintf(stderr, "%s: LimitSurface %.1f ms\n", named.name.c_str(), msSince(surfaceStart));
     double previous = 0;
     for (int level = 1; level <= maxLevel; ++level) {
       UniformOptions options;

@@ -142,22 +142,30 @@ describe("limn's page", () => {
   it("shows more triangles for more iterations, with the cage over the surface", async () => {
     await set("#draw-cage", true);
     await set("#shading", "flat");  // facets show the iteration count
-    let n = await set("#level", 1);
-    await waitForRenders(n + 1);
+    // Each step of the slider timed from the change to the new picture (the default engine).
+    timings.iterationsSliderMs = {};
+    const level = async (value) => {
+      const started = Date.now();
+      const n = await set("#level", value);
+      await waitForRenders(n + 1);
+      timings.iterationsSliderMs[value] = Date.now() - started;
+    };
+    await level(1);
     const one = await triangles();
     await shot("cage-level-1", page.locator("#view"));
-    n = await set("#level", 2);
-    await waitForRenders(n + 1);
+    await level(2);
     await shot("cage-level-2", page.locator("#view"));
-    n = await set("#level", 3);
-    await waitForRenders(n + 1);
+    await level(4);
+    await level(3);
     const three = await triangles();
     await shot("cage-level-3", page.locator("#view"));
+    console.log("iterations slider, change to picture (ms) by level: " +
+                JSON.stringify(timings.iterationsSliderMs));
     // The torus is all quads: each level splits a quad into four, two triangles each.
     assert.equal(one, 96 * 2 * 4);
     assert.equal(three, 96 * 2 * 64);
     assert.match(await page.textContent("#stats"), /12,288 triangles/);
-    n = await set("#shading", "smooth");
+    const n = await set("#shading", "smooth");
     await waitForRenders(n + 1);
   });
 

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "render/core/error.h"
+#include "render/core/parallel.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::tessellate {
@@ -94,6 +95,7 @@ TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
     subdiv::LimitSurface surface(cage);
     UniformOptions options;
     options.level = 2;
+    options.engine = UniformEngine::OpenSubdiv;
     TriangleMesh far = tessellateUniform(surface, options);
     // Level 0 is the cage for every engine (only the normals come from different evaluators).
     options.engine = UniformEngine::Masks;
@@ -119,6 +121,66 @@ TEST(Uniform, OwnRulesDrawWhatOpenSubdivDraws) {
       }
     }
   }
+}
+
+bool sameMesh(const TriangleMesh& a, const TriangleMesh& b) {
+  const auto same = [](const std::vector<Vec3f>& x, const std::vector<Vec3f>& y) {
+    return x.size() == y.size() && std::equal(x.begin(), x.end(), y.begin(), [](auto p, auto q) {
+             return p.x == q.x && p.y == q.y && p.z == q.z;
+           });
+  };
+  return same(a.positions, b.positions) && same(a.normals, b.normals) &&
+         same(a.limitPositions, b.limitPositions) && a.indices == b.indices &&
+         a.lines == b.lines;
+}
+
+// The refinement's loops write every element from one task: one thread and two draw the same
+// mesh bit for bit (quads with holes, a boundary, triangles, creases; and Loop's Topology path).
+TEST(Uniform, OneThreadAndTwoDrawTheSameMesh) {
+  mesh::ControlMesh creature = testing::creature(10);
+  creature.holes = {3, 40, 41};
+  for (const mesh::ControlMesh& cage : {creature, testing::icosahedron()}) {
+    subdiv::LimitSurface surface(cage);
+    for (UniformEngine engine : {UniformEngine::Auto, UniformEngine::Masks}) {
+      UniformOptions options;
+      options.level = 3;
+      options.engine = engine;
+      parallelThreadLimit() = 1;
+      TriangleMesh one = tessellateUniform(surface, options);
+      parallelThreadLimit() = 2;
+      TriangleMesh two = tessellateUniform(surface, options);
+      parallelThreadLimit() = 0;
+      EXPECT_GT(one.triangleCount(), 0u);
+      EXPECT_TRUE(sameMesh(one, two)) << mesh::schemeName(cage.scheme);
+    }
+  }
+}
+
+// "auto" takes limn's masks where they take the mesh and OpenSubdiv elsewhere: a non-manifold
+// mesh (three quads on one edge) is drawn, as OpenSubdiv draws it, not refused.
+TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
+  mesh::ControlMesh fin;
+  fin.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, -1, 0.2}, {1, -1, 0.2},
+                {0, 0.2, 1}, {1, 0.2, 1}};
+  testing::addFace(fin, {0, 1, 3, 2});
+  testing::addFace(fin, {1, 0, 4, 5});
+  testing::addFace(fin, {0, 1, 7, 6});
+  for (const mesh::ControlMesh& cage : {fin, testing::icosahedron()}) {
+    subdiv::LimitSurface surface(cage);
+    UniformOptions options;
+    options.level = 2;
+    options.engine = UniformEngine::OpenSubdiv;
+    const TriangleMesh far = tessellateUniform(surface, options);
+    options.engine = UniformEngine::Auto;
+    EXPECT_TRUE(sameMesh(tessellateUniform(surface, options), far));
+  }
+  subdiv::LimitSurface manifold(testing::torus());
+  UniformOptions options;
+  options.level = 2;
+  options.engine = UniformEngine::Masks;
+  const TriangleMesh masks = tessellateUniform(manifold, options);
+  options.engine = UniformEngine::Auto;
+  EXPECT_TRUE(sameMesh(tessellateUniform(manifold, options), masks));
 }
 
 TEST(Uniform, PushToLimitMovesEveryVertexToItsLimit) {
