@@ -241,8 +241,8 @@ QuadLevel refineQuads(const QuadLevel& p) {
         c.edgeVertices[half] = {edgePoint0 + e, w};
         c.edgeSharp[half] = p.edgeSharp[e];
         // In the child of the first face at w: its first corner's halfedge, or its last's.
-        c.edgeFirst[half] = p.vert[first] == w ? 4 * first + (first & 3)
-                                               : 4 * nextHalfedge(first) + (first & 3);
+        c.edgeFirst[half] =
+            p.vert[first] == w ? 4 * first + (first & 3) : 4 * nextHalfedge(first) + (first & 3);
       }
     }
   });
@@ -294,7 +294,8 @@ QuadLevel refineQuads(const QuadLevel& p) {
       if (p.edgeSharp[e] || other < 0) {
         edgePoint[e] = 0.5 * ends;
       } else {
-        edgePoint[e] = 0.25 * ends + 0.25 * (facePoint[faceOfHalfedge(first)] + facePoint[faceOfHalfedge(other)]);
+        edgePoint[e] = 0.25 * ends +
+                       0.25 * (facePoint[faceOfHalfedge(first)] + facePoint[faceOfHalfedge(other)]);
       }
     }
   });

@@ -60,8 +60,8 @@ inline int prevHalfedge(int h) { return (h & ~3) | ((h + 3) & 3); }
 inline int faceOfHalfedge(int h) { return h >> 2; }
 
 // Visits the ring of vertex v (which has a face) in orderedRing() order: visit(h) for each
-// outgoing halfedge h (face faceOfHalfedge(h), leading edge edge[h]). Returns the halfedge ending at v
-// that closes a boundary ring (its edge is the ring's last), or -1 for an interior ring.
+// outgoing halfedge h (face faceOfHalfedge(h), leading edge edge[h]). Returns the halfedge ending
+// at v that closes a boundary ring (its edge is the ring's last), or -1 for an interior ring.
 template <typename Visit>
 int forEachAround(const QuadLevel& q, int v, Visit visit) {
   const int start = q.vertexStart[v];

@@ -37,9 +37,9 @@ class RingLimit {
   explicit RingLimit(mesh::Scheme scheme);
 
   // The ring, in orderedRing() order (topology.h), filled by the caller before evaluate():
-  Vec3 v;                     // the vertex
-  std::vector<Vec3> E;        // the far end of each ring edge
-  std::vector<Vec3> F;        // Catmull-Clark: the corner of each ring face diagonal to v
+  Vec3 v;                      // the vertex
+  std::vector<Vec3> E;         // the far end of each ring edge
+  std::vector<Vec3> F;         // Catmull-Clark: the corner of each ring face diagonal to v
   std::vector<uint8_t> sharp;  // per ring edge: sharp at this level
   bool boundary = false;
 

@@ -130,8 +130,7 @@ bool sameMesh(const TriangleMesh& a, const TriangleMesh& b) {
            });
   };
   return same(a.positions, b.positions) && same(a.normals, b.normals) &&
-         same(a.limitPositions, b.limitPositions) && a.indices == b.indices &&
-         a.lines == b.lines;
+         same(a.limitPositions, b.limitPositions) && a.indices == b.indices && a.lines == b.lines;
 }
 
 // The refinement's loops write every element from one task: one thread and two draw the same
@@ -160,8 +159,8 @@ TEST(Uniform, OneThreadAndTwoDrawTheSameMesh) {
 // mesh (three quads on one edge) is drawn, as OpenSubdiv draws it, not refused.
 TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
   mesh::ControlMesh fin;
-  fin.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, -1, 0.2}, {1, -1, 0.2},
-                {0, 0.2, 1}, {1, 0.2, 1}};
+  fin.points = {{0, 0, 0},    {1, 0, 0},    {0, 1, 0},   {1, 1, 0},
+                {0, -1, 0.2}, {1, -1, 0.2}, {0, 0.2, 1}, {1, 0.2, 1}};
   testing::addFace(fin, {0, 1, 3, 2});
   testing::addFace(fin, {1, 0, 4, 5});
   testing::addFace(fin, {0, 1, 7, 6});
