@@ -49,13 +49,9 @@ Vec3 maskPoint(Rule rule, const Topology& t, const std::vector<Vec3>& P, int v, 
 // The edge point of edge e, from the parent points and the face points.
 Vec3 edgePointOf(const Topology& t, const std::vector<Vec3>& P, const Vec3* facePoint, int e) {
   const auto [a, b] = t.edgeVertices[e];
-  const float s = t.edgeSharpness[e];
+  // The edge point's own rule one level down: its two halves decide.
+  if (edgePointIsMidpoint(t, e)) return 0.5 * (P[a] + P[b]);
   std::span<const int> faces = t.edgeFacesOf(e);
-  if (isSharp(s)) {
-    // The edge point's own rule one level down: its two halves decide.
-    int sharpHalves = isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
-    if (sharpHalves == 2 || faces.size() != 2) return 0.5 * (P[a] + P[b]);
-  }
   // Smooth weights: ends vw each, face points fw each.
   double fw = 0.25, vw = 0.25;
   const bool smoothTriangles = t.options.triangleSubdivision == mesh::TriangleSubdivision::Smooth;
@@ -66,12 +62,7 @@ Vec3 edgePointOf(const Topology& t, const std::vector<Vec3>& P, const Vec3* face
     fw = 0.5 * (f0 + f1);
     vw = 0.5 * (1.0 - 2.0 * fw);
   }
-  if (isSharp(s)) {
-    // Semi-sharp, turning smooth in this step (or a Chaikin dart): blend by the sharpness.
-    const double w = s;
-    vw = w * 0.5 + (1.0 - w) * vw;
-    fw *= 1.0 - w;
-  }
+  blendTowardsMidpoint(t.edgeSharpness[e], vw, fw);
   return vw * (P[a] + P[b]) + fw * (facePoint[faces[0]] + facePoint[faces[1]]);
 }
 

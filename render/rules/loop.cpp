@@ -49,18 +49,10 @@ int opposite(const Topology& t, int f, int e) {
 // The edge point of edge e.
 Vec3 edgePointOf(const Topology& t, const std::vector<Vec3>& P, int e) {
   const auto [a, b] = t.edgeVertices[e];
-  const float s = t.edgeSharpness[e];
+  if (edgePointIsMidpoint(t, e)) return 0.5 * (P[a] + P[b]);
   std::span<const int> faces = t.edgeFacesOf(e);
-  if (isSharp(s)) {
-    int sharpHalves = isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
-    if (sharpHalves == 2 || faces.size() != 2) return 0.5 * (P[a] + P[b]);
-  }
   double vw = 0.375, fw = 0.125;
-  if (isSharp(s)) {
-    const double w = s;
-    vw = w * 0.5 + (1.0 - w) * vw;
-    fw *= 1.0 - w;
-  }
+  blendTowardsMidpoint(t.edgeSharpness[e], vw, fw);
   return vw * (P[a] + P[b]) + fw * (P[opposite(t, faces[0], e)] + P[opposite(t, faces[1], e)]);
 }
 

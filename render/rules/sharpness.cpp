@@ -32,6 +32,14 @@ float childEdgeSharpness(const Topology& t, int e, int v) {
   return isSharp(child) ? child : 0.0f;
 }
 
+bool edgePointIsMidpoint(const Topology& t, int e) {
+  if (!isSharp(t.edgeSharpness[e])) return false;
+  const auto [a, b] = t.edgeVertices[e];
+  const int sharpHalves =
+      isSharp(childEdgeSharpness(t, e, a)) + isSharp(childEdgeSharpness(t, e, b));
+  return sharpHalves == 2 || t.edgeFacesOf(e).size() != 2;
+}
+
 Rule currentRule(const Topology& t, int v) {
   int sharp = 0;
   for (int e : t.vertexEdgesOf(v)) sharp += isSharp(t.edgeSharpness[e]);

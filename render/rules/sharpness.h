@@ -47,6 +47,19 @@ inline Rule ruleOf(float vertexSharpness, int sharpEdges) {
 // The sharpness of the child of edge `e` that ends at its vertex `v` (an end of e).
 float childEdgeSharpness(const Topology& t, int e, int v);
 
+// Whether the point of edge e is its midpoint (the sharp rule): a sharp edge whose two halves
+// stay sharp one level down, or a sharp edge without two faces.
+bool edgePointIsMidpoint(const Topology& t, int e);
+
+// The smooth edge-point weights of a semi-sharp edge turning smooth in this step (sharpness s,
+// or a Chaikin dart), blended towards the midpoint by s: vw per end, fw per face term.
+inline void blendTowardsMidpoint(float s, double& vw, double& fw) {
+  if (!isSharp(s)) return;
+  const double w = s;
+  vw = w * 0.5 + (1.0 - w) * vw;
+  fw *= 1.0 - w;
+}
+
 // Per vertex of `t`: the rule of the vertex itself, and of its child one level down.
 struct VertexRules {
   std::vector<Rule> parent, child;
