@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <new>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -20,10 +21,14 @@ struct DefaultInitAllocator : std::allocator<T> {
   DefaultInitAllocator() = default;
   template <typename U>
   DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
-  // resize(n) without a value: default-initialise (nothing, for int or double).
+  // resize(n) without a value: nothing for types whose objects the allocation itself brings to
+  // life (trivially copyable and destructible: int, std::array<int, 2>, Vec3 despite its zero
+  // member initialisers), default-initialisation otherwise.
   template <typename U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
+    if constexpr (!(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>)) {
+      ::new (static_cast<void*>(p)) U;
+    }
   }
   template <typename U, typename... Args>
   void construct(U* p, Args&&... args) {

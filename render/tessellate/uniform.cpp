@@ -244,17 +244,27 @@ TriangleMesh assemble(const Refined& r, bool pushToLimit) {
   return out;
 }
 
-// Indices [0, count) that `keep` keeps, in order: where each kept element goes in a compacted
-// array (the kept ones' rank), and how many are kept.
+// Where each element that `keep` keeps goes in a compacted array (its rank among the kept),
+// and how many are kept; with keepAll, every element where it is (no pass over them).
+struct Ranks {
+  std::vector<uint32_t> rank;
+  size_t kept = 0;
+  size_t of(size_t i) const { return rank.empty() ? i : rank[i]; }
+};
+
 template <typename Keep>
-std::vector<uint32_t> ranksOf(size_t count, Keep keep, size_t& kept) {
-  std::vector<uint32_t> rank(count);
-  kept = 0;
-  for (size_t i = 0; i < count; ++i) {
-    rank[i] = static_cast<uint32_t>(kept);
-    kept += keep(i) ? 1 : 0;
+Ranks ranksOf(size_t count, bool keepAll, Keep keep) {
+  Ranks out;
+  if (keepAll) {
+    out.kept = count;
+    return out;
   }
-  return rank;
+  out.rank.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    out.rank[i] = static_cast<uint32_t>(out.kept);
+    out.kept += keep(i) ? 1 : 0;
+  }
+  return out;
 }
 
 // A level refined as quads (rules/quad_level.h), straight into the mesh the rasteriser takes:
@@ -269,15 +279,16 @@ TriangleMesh assembleQuads(const rules::QuadLevel& q, bool pushToLimit, StageTim
                        out.normals.data());
   timer.lap(&UniformOptions::Stages::limitMs);
 
-  size_t drawnFaces = 0;
-  const std::vector<uint32_t> faceRank = ranksOf(
-      q.faceCount(), [&](size_t f) { return !q.faceHole[f]; }, drawnFaces);
-  out.indices.resize(6 * drawnFaces);
+  // Without holes every face and edge is drawn, in order.
+  const bool noHoles =
+      std::none_of(q.faceHole.begin(), q.faceHole.end(), [](uint8_t h) { return h; });
+  const Ranks faceRank = ranksOf(q.faceCount(), noHoles, [&](size_t f) { return !q.faceHole[f]; });
+  out.indices.resize(6 * faceRank.kept);
   parallelFor(q.faceCount(), kGrain, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       if (q.faceHole[f]) continue;
       const int* c = q.vert.data() + 4 * f;
-      uint32_t* t = out.indices.data() + 6 * size_t{faceRank[f]};
+      uint32_t* t = out.indices.data() + 6 * faceRank.of(f);
       const uint32_t corner[4] = {static_cast<uint32_t>(c[0]), static_cast<uint32_t>(c[1]),
                                   static_cast<uint32_t>(c[2]), static_cast<uint32_t>(c[3])};
       t[0] = corner[0], t[1] = corner[1], t[2] = corner[2];
@@ -290,14 +301,13 @@ TriangleMesh assembleQuads(const rules::QuadLevel& q, bool pushToLimit, StageTim
     return !q.faceHole[rules::faceOfHalfedge(first)] ||
            (other >= 0 && !q.faceHole[rules::faceOfHalfedge(other)]);
   };
-  size_t drawnEdges = 0;
-  const std::vector<uint32_t> edgeRank = ranksOf(q.edgeCount(), drawnEdge, drawnEdges);
-  out.lines.resize(2 * drawnEdges);
+  const Ranks edgeRank = ranksOf(q.edgeCount(), noHoles, drawnEdge);
+  out.lines.resize(2 * edgeRank.kept);
   parallelFor(q.edgeCount(), kGrain, [&](size_t begin, size_t end) {
     for (size_t e = begin; e < end; ++e) {
-      if (!drawnEdge(e)) continue;
-      out.lines[2 * size_t{edgeRank[e]}] = static_cast<uint32_t>(q.edgeVertices[e][0]);
-      out.lines[2 * size_t{edgeRank[e]} + 1] = static_cast<uint32_t>(q.edgeVertices[e][1]);
+      if (!noHoles && !drawnEdge(e)) continue;
+      out.lines[2 * edgeRank.of(e)] = static_cast<uint32_t>(q.edgeVertices[e][0]);
+      out.lines[2 * edgeRank.of(e) + 1] = static_cast<uint32_t>(q.edgeVertices[e][1]);
     }
   });
   timer.lap(&UniformOptions::Stages::meshMs);
