@@ -26,7 +26,9 @@ cmake --build build-sanitize -j "$jobs"
 # leaves allocations whose stacks LSan can no longer attribute ("<unknown module>"), so no
 # suppression can name them. The fuzz targets (scripts/fuzz.sh), which never load Mesa, run
 # with leak detection on.
-export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:strict_string_checks=1"
+# handle_segv=0: a worker that segfaults dies of SIGSEGV as in production (worker_isolation_test
+# kills one with it and checks the signal named), not of ASan's abort.
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:strict_string_checks=1:handle_segv=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 [ $# -eq 0 ] && set -- -LE 'slow|heavy'
 cd build-sanitize

@@ -60,7 +60,8 @@ class Reader {
     const uint64_t count = pod<uint64_t>();
     if (count > rest_.size() / sizeof(T)) throw ProtocolError("truncated worker message");
     std::vector<T> values(count);
-    std::memcpy(values.data(), take(count * sizeof(T)).data(), count * sizeof(T));
+    // An empty vector's data() may be null, which memcpy must not be given even for 0 bytes.
+    if (count > 0) std::memcpy(values.data(), take(count * sizeof(T)).data(), count * sizeof(T));
     return values;
   }
 

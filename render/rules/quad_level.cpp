@@ -193,9 +193,9 @@ QuadLevel refineQuads(const QuadLevel& p) {
   const int facePoint0 = V, edgePoint0 = V + F;
   QuadLevel c;
   c.vertexCount = V + F + E;
-  c.vert.resize(4 * size_t{H});
-  c.edge.resize(4 * size_t{H});
-  c.twin.resize(4 * size_t{H});
+  c.vert.resize(4 * static_cast<size_t>(H));
+  c.edge.resize(4 * static_cast<size_t>(H));
+  c.twin.resize(4 * static_cast<size_t>(H));
   c.faceHole.resize(H);
   parallelFor(H, kParallelGrain, [&](size_t begin, size_t end) {
     for (int h = static_cast<int>(begin); h < static_cast<int>(end); ++h) {
@@ -224,7 +224,7 @@ QuadLevel refineQuads(const QuadLevel& p) {
     }
   });
 
-  c.edgeVertices.resize(H + 2 * size_t{E});
+  c.edgeVertices.resize(H + 2 * static_cast<size_t>(E));
   c.edgeFirst.resize(c.edgeVertices.size());
   c.edgeSharp.assign(c.edgeVertices.size(), 0);
   parallelFor(H, kParallelGrain, [&](size_t begin, size_t end) {

@@ -104,8 +104,8 @@ Topology splitToQuads(const Topology& p) {
   c.faceVertices.resize(4 * corners);
   c.faceEdges.resize(4 * corners);
   c.faceHole.resize(corners);
-  parallelFor(F, kParallelGrain, [&](size_t f, size_t lastFace) {
-    for (; f < lastFace; ++f) {
+  parallelFor(F, kParallelGrain, [&](size_t begin, size_t end) {
+    for (int f = static_cast<int>(begin); f < static_cast<int>(end); ++f) {
       std::span<const int> fv = p.faceVerts(f), fe = p.faceEdgesOf(f);
       const int n = static_cast<int>(fv.size()), base = p.faceOffsets[f];
       for (int i = 0; i < n; ++i) {

@@ -242,7 +242,8 @@ TEST(WorkerIsolation, ARequestPastTheMemoryCeilingCostsOnlyItself) {
   size_t idleBytes = 0;
   {
     ServerProcess probe;
-    for (const auto& w : health(probe.port())["workerStates"].GetArray()) {
+    const rapidjson::Document states = health(probe.port());  // outlives the loop over it
+    for (const auto& w : states["workerStates"].GetArray()) {
       const int pid = w["pid"].GetInt();
       CommandResult statm = runCommand("cat /proc/" + std::to_string(pid) + "/statm");
       size_t pages = 0, resident = 0;
