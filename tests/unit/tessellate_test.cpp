@@ -173,6 +173,20 @@ TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
     options.engine = UniformEngine::Auto;
     EXPECT_TRUE(sameMesh(tessellateUniform(surface, options), far));
   }
+  // A vertex in no face stays where it is, without a normal, in both engines.
+  mesh::ControlMesh loose = testing::cube();
+  loose.points.push_back({3, 3, 3});
+  subdiv::LimitSurface withLoose(loose);
+  UniformOptions looseOptions;
+  looseOptions.level = 2;
+  looseOptions.engine = UniformEngine::OpenSubdiv;
+  const TriangleMesh farLoose = tessellateUniform(withLoose, looseOptions);
+  looseOptions.engine = UniformEngine::Auto;
+  const TriangleMesh autoLoose = tessellateUniform(withLoose, looseOptions);
+  ASSERT_EQ(autoLoose.positions.size(), farLoose.positions.size());
+  EXPECT_EQ(length(autoLoose.positions[8].toDouble() - Vec3{3, 3, 3}), 0.0);
+  EXPECT_EQ(autoLoose.indices, farLoose.indices);
+
   subdiv::LimitSurface manifold(testing::torus());
   UniformOptions options;
   options.level = 2;
