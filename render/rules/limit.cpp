@@ -150,21 +150,24 @@ void RingLimit::smooth() {
   faceNormals.assign(n, unitCross(t));
 }
 
+SmoothWeights smoothWeightsOf(int n) {
+  SmoothWeights w;
+  const double theta = 2.0 * kPi / n;
+  for (int i = 0; i < n; ++i) {
+    w.cosines.push_back(std::cos(i * theta));
+    w.sines.push_back(std::sin(i * theta));
+  }
+  const double lambda =
+      5.0 / 16.0 +
+      (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
+  w.faceScale = 1.0 / (4.0 * lambda - 1.0);
+  return w;
+}
+
 const SmoothWeights& RingLimit::weights(int n) {
   if (static_cast<int>(weights_.size()) <= n) weights_.resize(n + 1);
-  SmoothWeights& w = weights_[n];
-  if (w.cosines.empty()) {
-    const double theta = 2.0 * kPi / n;
-    for (int i = 0; i < n; ++i) {
-      w.cosines.push_back(std::cos(i * theta));
-      w.sines.push_back(std::sin(i * theta));
-    }
-    const double lambda =
-        5.0 / 16.0 +
-        (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
-    w.faceScale = 1.0 / (4.0 * lambda - 1.0);
-  }
-  return w;
+  if (weights_[n].cosines.empty()) weights_[n] = smoothWeightsOf(n);
+  return weights_[n];
 }
 
 namespace {

@@ -1,8 +1,6 @@
 #include "render/rules/quad_level.h"
 
 #include <algorithm>
-#include <cmath>
-#include <numbers>
 
 #include "render/core/parallel.h"
 #include "render/rules/ring_limit.h"
@@ -55,20 +53,6 @@ Vec3 vertexPoint(const QuadLevel& q, const Vec3* facePoint, int v) {
   return p;
 }
 
-// The tangent weights of a regular vertex, computed as RingLimit computes them for valence 4.
-struct RegularWeights {
-  double c[4];
-  double faceScale;
-  RegularWeights() {
-    const double theta = 2.0 * std::numbers::pi / 4;
-    for (int i = 0; i < 4; ++i) c[i] = std::cos(i * theta);
-    const double lambda =
-        5.0 / 16.0 +
-        (std::cos(theta) + std::cos(theta / 2) * std::sqrt(2.0 * (9.0 + std::cos(theta)))) / 16.0;
-    faceScale = 1.0 / (4.0 * lambda - 1.0);
-  }
-};
-
 // The ring of a regular vertex: the far ends of its edges E and the corners diagonal to it F;
 // face i is (v, E[i], F[i], E[i + 1]) counter-clockwise.
 struct RegularRing {
@@ -89,15 +73,16 @@ RegularRing regularRing(const QuadLevel& q, int v) {
 // The limit of a regular vertex by the bicubic B-spline's masks, as RingLimit computes them for
 // valence 4 but without its buffers.
 void regularLimit(const Vec3& p, const RegularRing& r, Vec3& position, Vec3& normal) {
-  static const RegularWeights w;
+  static const SmoothWeights w = smoothWeightsOf(4);
+  const std::vector<double>& c = w.cosines;
   position = catmullClarkLimitVertexWeight(4) * p +
              catmullClarkLimitEdgeWeight(4) * (r.E[0] + r.E[1] + r.E[2] + r.E[3]) +
              catmullClarkLimitFaceWeight(4) * (r.F[0] + r.F[1] + r.F[2] + r.F[3]);
   Tangents t;
   for (int i = 0; i < 4; ++i) {
     const int prev = (i + 3) & 3, next = (i + 1) & 3;
-    t.t1 += 4.0 * w.c[i] * r.E[i] + w.faceScale * (w.c[i] + w.c[next]) * r.F[i];
-    t.t2 += 4.0 * w.c[prev] * r.E[i] + w.faceScale * (w.c[prev] + w.c[i]) * r.F[i];
+    t.t1 += 4.0 * c[i] * r.E[i] + w.faceScale * (c[i] + c[next]) * r.F[i];
+    t.t2 += 4.0 * c[prev] * r.E[i] + w.faceScale * (c[prev] + c[i]) * r.F[i];
   }
   normal = unitCross(t);
 }

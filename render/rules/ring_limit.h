@@ -24,6 +24,9 @@ struct SmoothWeights {
   double faceScale = 0;                // Catmull-Clark: 1 / (4 lambda - 1)
 };
 
+// The smooth-tangent weights at valence n (Catmull-Clark and Loop share the cosines).
+SmoothWeights smoothWeightsOf(int n);
+
 // One side of a vertex: the ends of its edges E[0..m] and, for Catmull-Clark, the corners
 // diagonal to the vertex in its faces F[0..m-1] (face i between edges i and i+1), in
 // counter-clockwise order. Used for the two sides of a crease and the whole of a boundary.
