@@ -4,6 +4,8 @@
 #include <opensubdiv/sdc/catmarkScheme.h>
 #include <opensubdiv/sdc/loopScheme.h>
 
+#include "render/core/parallel.h"
+
 namespace limn::render::subdiv {
 
 namespace Far = OpenSubdiv::Far;
@@ -77,35 +79,40 @@ void limitWith(const Far::TopologyRefiner& refiner, const FarPoint* src,
   limit.assign(size_t(vertexCount), FarPoint{});
   du.assign(size_t(vertexCount), FarPoint{});
   dv.assign(size_t(vertexCount), FarPoint{});
-  Mask position, tangent1, tangent2;
-  std::vector<int> edgeEnds, faceOpposite;
-  for (int v = 0; v < vertexCount; ++v) {
-    Far::ConstIndexArray edges = level.GetVertexEdges(v);
-    Far::ConstIndexArray faces = level.GetVertexFaces(v);
-    if (edges.size() == 0) {
-      limit[size_t(v)] = src[v];
-      continue;
-    }
-    // Every mask has room for all of this vertex's edges and faces.
-    for (Mask* mask : {&position, &tangent1, &tangent2}) mask->reserve(edges.size(), faces.size());
-    scheme.ComputeVertexLimitMask(Neighborhood(level, v), position, tangent1, tangent2,
-                                  level.GetVertexRule(v));
+  // Every vertex's masks from its own neighbourhood: chunks of vertices in parallel, each with
+  // its own buffers.
+  parallelFor(vertexCount, 8192, [&](size_t begin, size_t end) {
+    Mask position, tangent1, tangent2;
+    std::vector<int> edgeEnds, faceOpposite;
+    for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
+      Far::ConstIndexArray edges = level.GetVertexEdges(v);
+      Far::ConstIndexArray faces = level.GetVertexFaces(v);
+      if (edges.size() == 0) {
+        limit[size_t(v)] = src[v];
+        continue;
+      }
+      // Every mask has room for all of this vertex's edges and faces.
+      for (Mask* mask : {&position, &tangent1, &tangent2})
+        mask->reserve(edges.size(), faces.size());
+      scheme.ComputeVertexLimitMask(Neighborhood(level, v), position, tangent1, tangent2,
+                                    level.GetVertexRule(v));
 
-    edgeEnds.resize(size_t(edges.size()));
-    for (int i = 0; i < edges.size(); ++i) {
-      Far::ConstIndexArray ends = level.GetEdgeVertices(edges[i]);
-      edgeEnds[size_t(i)] = ends[0] == v ? ends[1] : ends[0];
+      edgeEnds.resize(size_t(edges.size()));
+      for (int i = 0; i < edges.size(); ++i) {
+        Far::ConstIndexArray ends = level.GetEdgeVertices(edges[i]);
+        edgeEnds[size_t(i)] = ends[0] == v ? ends[1] : ends[0];
+      }
+      faceOpposite.resize(size_t(faces.size()));
+      Far::ConstLocalIndexArray inFace = level.GetVertexFaceLocalIndices(v);
+      for (int i = 0; i < faces.size(); ++i) {
+        Far::ConstIndexArray corners = level.GetFaceVertices(faces[i]);
+        faceOpposite[size_t(i)] = corners[(inFace[i] + 2) % corners.size()];
+      }
+      limit[size_t(v)] = position.apply(src, v, edgeEnds, faceOpposite);
+      du[size_t(v)] = tangent1.apply(src, v, edgeEnds, faceOpposite);
+      dv[size_t(v)] = tangent2.apply(src, v, edgeEnds, faceOpposite);
     }
-    faceOpposite.resize(size_t(faces.size()));
-    Far::ConstLocalIndexArray inFace = level.GetVertexFaceLocalIndices(v);
-    for (int i = 0; i < faces.size(); ++i) {
-      Far::ConstIndexArray corners = level.GetFaceVertices(faces[i]);
-      faceOpposite[size_t(i)] = corners[(inFace[i] + 2) % corners.size()];
-    }
-    limit[size_t(v)] = position.apply(src, v, edgeEnds, faceOpposite);
-    du[size_t(v)] = tangent1.apply(src, v, edgeEnds, faceOpposite);
-    dv[size_t(v)] = tangent2.apply(src, v, edgeEnds, faceOpposite);
-  }
+  });
 }
 
 }  // namespace
