@@ -1,7 +1,9 @@
 // Uniform refinement of the cage, by OpenSubdiv's Far (positions interpolated level by level,
-// then PrimvarRefiner::Limit) or by limn's own rules (render/rules: masks or factored, then the
-// limit masks). Both give every vertex of the last level its refined position, its limit
-// position and its limit normal; the mesh is assembled from those the same way.
+// then the limit masks, far_limit.h) or by limn's own rules (render/rules: masks or factored,
+// then the limit masks). Every vertex of the last level gets its refined position, its limit
+// position and its limit normal; assemble() makes the mesh from those. The masks' levels that
+// run as quads (rules/quad_level.h) skip that step: assembleQuads() writes the mesh straight
+// from the halfedges.
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
@@ -39,7 +41,7 @@ struct Refined {
   int faceCount() const { return static_cast<int>(faceOffsets.size()) - 1; }
 };
 
-// Milliseconds since `start`, added to *stage when timing is asked for.
+// Adds the time since the previous lap to one stage of UniformOptions::stages, when asked for.
 class StageTimer {
  public:
   explicit StageTimer(UniformOptions::Stages* stages) : stages_(stages) {}
