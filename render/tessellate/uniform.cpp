@@ -10,7 +10,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <optional>
 #include <string>
 
 #include "render/core/error.h"

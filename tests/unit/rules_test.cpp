@@ -237,6 +237,19 @@ TEST_P(EveryShape, QuadLevelsRefineAsTheTopologyPath) {
       ASSERT_LE(length(quadLimit.normals[v] - limit.normals[v]), 1e-9)
           << "level " << l << " vertex " << v;
     }
+    // What the renderer takes from the same pass (floats): the refined point, its limit, and
+    // the limit normal, turned to its faces' side where it pointed away.
+    std::vector<Vec3f> drawn(q.vertexCount), drawnLimit(q.vertexCount), drawnNormal(q.vertexCount);
+    drawnVertices(q, false, drawn.data(), drawnLimit.data(), drawnNormal.data());
+    const double floatTolerance = 1e-6 * shape.mesh.bounds().diagonal() + 1e-6;
+    for (int v = 0; v < q.vertexCount; ++v) {
+      ASSERT_LE(length(drawn[v].toDouble() - level->points[v]), floatTolerance) << "v " << v;
+      ASSERT_LE(length(drawnLimit[v].toDouble() - limit.positions[v]), floatTolerance)
+          << "level " << l << " vertex " << v;
+      if (length(limit.normals[v]) == 0) continue;
+      ASSERT_GE(std::abs(dot(drawnNormal[v].toDouble(), limit.normals[v])), 1 - 1e-6)
+          << "level " << l << " vertex " << v;
+    }
   }
   RecordProperty("quadLevels", quadLevels);
 }

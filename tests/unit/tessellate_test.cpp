@@ -155,6 +155,14 @@ TEST(Uniform, OneThreadAndTwoDrawTheSameMesh) {
   }
 }
 
+TriangleMesh drawnBy(const mesh::ControlMesh& cage, UniformEngine engine, int level = 2) {
+  subdiv::LimitSurface surface(cage);
+  UniformOptions options;
+  options.level = level;
+  options.engine = engine;
+  return tessellateUniform(surface, options);
+}
+
 // "auto" takes limn's masks where they take the mesh and OpenSubdiv elsewhere: a non-manifold
 // mesh (three quads on one edge) is drawn, as OpenSubdiv draws it, not refused.
 TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
@@ -165,35 +173,20 @@ TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
   testing::addFace(fin, {1, 0, 4, 5});
   testing::addFace(fin, {0, 1, 7, 6});
   for (const mesh::ControlMesh& cage : {fin, testing::icosahedron()}) {
-    subdiv::LimitSurface surface(cage);
-    UniformOptions options;
-    options.level = 2;
-    options.engine = UniformEngine::OpenSubdiv;
-    const TriangleMesh far = tessellateUniform(surface, options);
-    options.engine = UniformEngine::Auto;
-    EXPECT_TRUE(sameMesh(tessellateUniform(surface, options), far));
+    EXPECT_TRUE(
+        sameMesh(drawnBy(cage, UniformEngine::Auto), drawnBy(cage, UniformEngine::OpenSubdiv)));
   }
   // A vertex in no face stays where it is, without a normal, in both engines.
   mesh::ControlMesh loose = testing::cube();
   loose.points.push_back({3, 3, 3});
-  subdiv::LimitSurface withLoose(loose);
-  UniformOptions looseOptions;
-  looseOptions.level = 2;
-  looseOptions.engine = UniformEngine::OpenSubdiv;
-  const TriangleMesh farLoose = tessellateUniform(withLoose, looseOptions);
-  looseOptions.engine = UniformEngine::Auto;
-  const TriangleMesh autoLoose = tessellateUniform(withLoose, looseOptions);
+  const TriangleMesh farLoose = drawnBy(loose, UniformEngine::OpenSubdiv);
+  const TriangleMesh autoLoose = drawnBy(loose, UniformEngine::Auto);
   ASSERT_EQ(autoLoose.positions.size(), farLoose.positions.size());
   EXPECT_EQ(length(autoLoose.positions[8].toDouble() - Vec3{3, 3, 3}), 0.0);
   EXPECT_EQ(autoLoose.indices, farLoose.indices);
 
-  subdiv::LimitSurface manifold(testing::torus());
-  UniformOptions options;
-  options.level = 2;
-  options.engine = UniformEngine::Masks;
-  const TriangleMesh masks = tessellateUniform(manifold, options);
-  options.engine = UniformEngine::Auto;
-  EXPECT_TRUE(sameMesh(tessellateUniform(manifold, options), masks));
+  EXPECT_TRUE(sameMesh(drawnBy(testing::torus(), UniformEngine::Auto),
+                       drawnBy(testing::torus(), UniformEngine::Masks)));
 }
 
 TEST(Uniform, PushToLimitMovesEveryVertexToItsLimit) {
