@@ -9,13 +9,14 @@
 //   opensubdiv      tessellateUniform with the OpenSubdiv engine (Far refinement, limit masks,
 //                   mesh): what `"engine": "opensubdiv"` costs a request;
 //   masks           tessellateUniform with limn's own rules: its levels after the first few run
-//                   as quads on halfedges, in parallel (render/rules/quad_level.h); refine, limit
-//                   and mesh are its stages. "1 thread" is the same on one thread, and "same"
-//                   says whether the two meshes are identical bit for bit.
+//                   on halfedges (quads, or Loop's triangles), in parallel
+//                   (render/rules/halfedge_level.h); refine, limit and mesh are its stages. "1
+//                   thread" is the same on one thread, and "same" says whether the two meshes are
+//                   identical bit for bit.
 // Mvert/s: output vertices per second of the masks engine, refinement + limit + mesh.
 // vs 4x prev: the masks time over 4 times the previous level's (1.0: exactly linear).
 //
-//   uniform_bench [--repeat N] [--max-level L]
+//   uniform_bench [--repeat N] [--max-level L] [--only TEXT]   (TEXT: part of the meshes' names)
 #include <opensubdiv/far/primvarRefiner.h>
 
 #include <algorithm>
@@ -69,6 +70,12 @@ std::vector<NamedMesh> meshes() {
       {"creature(56) (" + std::to_string(testing::creature(56).faceCount()) + " faces)",
        testing::creature(56)},
       {"icosahedron.obj (Loop)", example("icosahedron.obj", Scheme::Loop)},
+      {"loopCreature(16) (Loop, " + std::to_string(testing::loopCreature(16).faceCount()) +
+           " faces)",
+       testing::loopCreature(16)},
+      {"loopCreature(32) (Loop, " + std::to_string(testing::loopCreature(32).faceCount()) +
+           " faces)",
+       testing::loopCreature(32)},
   };
 }
 
@@ -136,16 +143,19 @@ bool identical(const TriangleMesh& a, const TriangleMesh& b) {
 
 int main(int argc, char** argv) {
   int repeat = 3, maxLevel = 5;
+  std::string only;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     if (flag == "--repeat") repeat = std::stoi(argv[i + 1]);
     if (flag == "--max-level") maxLevel = std::stoi(argv[i + 1]);
+    if (flag == "--only") only = argv[i + 1];
   }
   std::printf(
       "| mesh | level | vertices | Far positions ms | opensubdiv ms | masks ms (refine + limit + "
       "mesh) | masks 1 thread ms | same | masks / Far positions | Mvert/s | vs 4x prev |\n");
   std::printf("|---|---:|---:|---:|---:|---|---:|:---:|---:|---:|---:|\n");
   for (const NamedMesh& named : meshes()) {
+    if (named.name.find(only) == std::string::npos) continue;
     render::subdiv::LimitSurface surface(named.mesh);
     double previous = 0;
     for (int level = 1; level <= maxLevel; ++level) {

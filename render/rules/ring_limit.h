@@ -1,6 +1,6 @@
 // RingLimit: the limit masks of one vertex from its ordered one-ring (limit.h describes the
-// masks), shared by limitOf() over a Topology and the quad levels' limit (quad_level.h), which
-// read their rings differently. Internal to render/rules.
+// masks), shared by limitOf() over a Topology and the halfedge levels' limit (halfedge_level.h),
+// which read their rings differently. Internal to render/rules.
 #pragma once
 
 #include <cstdint>

@@ -21,8 +21,8 @@ TriangleMesh tessellateCoarse(const subdiv::LimitSurface& surface);
 // Which implementation of the subdivision rules refines a uniform mesh: OpenSubdiv's Far, or
 // limn's own (render/rules) by masks or, for Catmull-Clark, in factored form. All three give
 // the same vertices in the same order where their rules agree (docs/engine.md). Auto, the
-// fastest that takes the mesh: the masks for manifold Catmull-Clark meshes (their levels run as
-// quads on halfedges, in parallel), OpenSubdiv for Loop, bilinear and non-manifold meshes.
+// fastest that takes the mesh: the masks for manifold Catmull-Clark and Loop meshes (their
+// levels run on halfedges, in parallel), OpenSubdiv for bilinear and non-manifold meshes.
 enum class UniformEngine { Auto, OpenSubdiv, Masks, Factored };
 
 struct UniformOptions {

@@ -2,8 +2,8 @@
 // then the limit masks, far_limit.h) or by limn's own rules (render/rules: masks or factored,
 // then the limit masks). Every vertex of the last level gets its refined position, its limit
 // position and its limit normal; assemble() makes the mesh from those. The masks' levels that
-// run as quads (rules/quad_level.h) skip that step: assembleQuads() writes the mesh straight
-// from the halfedges.
+// run on halfedges (rules/halfedge_level.h) skip that step: assembleHalfedges() writes the mesh
+// straight from them.
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
@@ -14,8 +14,8 @@
 
 #include "render/core/error.h"
 #include "render/core/parallel.h"
+#include "render/rules/halfedge_level.h"
 #include "render/rules/limit.h"
-#include "render/rules/quad_level.h"
 #include "render/rules/refine.h"
 #include "render/subdiv/far_limit.h"
 #include "render/subdiv/far_point.h"
@@ -268,10 +268,12 @@ Ranks ranksOf(size_t count, bool keepAll, Keep keep) {
   return out;
 }
 
-// A level refined as quads (rules/quad_level.h), straight into the mesh the rasteriser takes:
-// the vertices in one pass over their rings, two triangles per quad that is not a hole, and
-// the edges of the quads drawn.
-TriangleMesh assembleQuads(const rules::QuadLevel& q, bool pushToLimit, StageTimer& timer) {
+// A level refined on halfedges (rules/halfedge_level.h), straight into the mesh the rasteriser
+// takes: the vertices in one pass over their rings, the faces that are not holes as triangles
+// (a quad as two), and the edges of the faces drawn.
+template <int N>
+TriangleMesh assembleHalfedges(const rules::HalfedgeLevel<N>& q, bool pushToLimit,
+                               StageTimer& timer) {
   TriangleMesh out;
   out.positions.resize(q.vertexCount);
   out.limitPositions.resize(q.vertexCount);
@@ -284,23 +286,25 @@ TriangleMesh assembleQuads(const rules::QuadLevel& q, bool pushToLimit, StageTim
   const bool noHoles =
       std::none_of(q.faceHole.begin(), q.faceHole.end(), [](uint8_t h) { return h; });
   const Ranks faceRank = ranksOf(q.faceCount(), noHoles, [&](size_t f) { return !q.faceHole[f]; });
-  out.indices.resize(6 * faceRank.kept);
+  constexpr int kIndicesPerFace = 3 * (N - 2);
+  out.indices.resize(kIndicesPerFace * faceRank.kept);
   parallelFor(q.faceCount(), kGrain, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       if (q.faceHole[f]) continue;
-      const int* c = q.vert.data() + 4 * f;
-      uint32_t* t = out.indices.data() + 6 * faceRank.of(f);
-      const uint32_t corner[4] = {static_cast<uint32_t>(c[0]), static_cast<uint32_t>(c[1]),
-                                  static_cast<uint32_t>(c[2]), static_cast<uint32_t>(c[3])};
-      t[0] = corner[0], t[1] = corner[1], t[2] = corner[2];
-      t[3] = corner[0], t[4] = corner[2], t[5] = corner[3];
+      const int* c = q.vert.data() + N * f;
+      uint32_t* t = out.indices.data() + kIndicesPerFace * faceRank.of(f);
+      for (int k = 1; k + 1 < N; ++k, t += 3) {  // fanned from the first corner
+        t[0] = static_cast<uint32_t>(c[0]);
+        t[1] = static_cast<uint32_t>(c[k]);
+        t[2] = static_cast<uint32_t>(c[k + 1]);
+      }
     }
   });
 
   const auto drawnEdge = [&](size_t e) {
     const int first = q.edgeFirst[e], other = q.twin[first];
-    return !q.faceHole[rules::faceOfHalfedge(first)] ||
-           (other >= 0 && !q.faceHole[rules::faceOfHalfedge(other)]);
+    return !q.faceHole[rules::faceOfHalfedge<N>(first)] ||
+           (other >= 0 && !q.faceHole[rules::faceOfHalfedge<N>(other)]);
   };
   const Ranks edgeRank = ranksOf(q.edgeCount(), noHoles, drawnEdge);
   out.lines.resize(2 * edgeRank.kept);
@@ -315,7 +319,7 @@ TriangleMesh assembleQuads(const rules::QuadLevel& q, bool pushToLimit, StageTim
   return out;
 }
 
-// limn's own rules: the masks run their last levels as quads where the mesh allows
+// limn's own rules: the masks run their last levels on halfedges where the mesh allows
 // (rules::refineUniformFast), the factored method level by level on the Topology.
 TriangleMesh tessellateWithRules(const mesh::ControlMesh& cage, const UniformOptions& o,
                                  rules::Method method) {
@@ -324,7 +328,8 @@ TriangleMesh tessellateWithRules(const mesh::ControlMesh& cage, const UniformOpt
   if (method == rules::Method::Masks) {
     rules::FastRefinement fast = rules::refineUniformFast(cage, o.level);
     timer.lap(&UniformOptions::Stages::refineMs);
-    if (fast.quads) return assembleQuads(*fast.quads, o.pushToLimit, timer);
+    if (fast.quads) return assembleHalfedges(*fast.quads, o.pushToLimit, timer);
+    if (fast.triangles) return assembleHalfedges(*fast.triangles, o.pushToLimit, timer);
     level = std::move(fast.level);
   } else {
     level = rules::refineUniform(cage, o.level, method);
@@ -353,7 +358,7 @@ TriangleMesh tessellateUniform(const subdiv::LimitSurface& surface, const Unifor
     if (!whyNot.empty()) throw InputError(InputError::Kind::InvalidParameter, "engine", whyNot);
     return tessellateWithRules(cage, o, method);
   }
-  if (o.engine == UniformEngine::Auto && o.level > 0 && cage.scheme == mesh::Scheme::CatmullClark &&
+  if (o.engine == UniformEngine::Auto && o.level > 0 &&
       rules::unsupportedReason(cage, rules::Method::Masks).empty()) {
     try {
       return tessellateWithRules(cage, o, rules::Method::Masks);

@@ -17,8 +17,8 @@
 
 #include "api/obj_reader.h"
 #include "render/core/error.h"
+#include "render/rules/halfedge_level.h"
 #include "render/rules/limit.h"
-#include "render/rules/quad_level.h"
 #include "render/rules/refine.h"
 #include "render/rules/weights.h"
 #include "render/subdiv/far_point.h"
@@ -82,6 +82,10 @@ std::vector<Shape> allShapes() {
   shapes.push_back({"own_grid", testing::grid(5)});
   shapes.push_back({"own_icosahedron", testing::icosahedron()});
   shapes.push_back({"own_octahedron_loop", testing::octahedron(Scheme::Loop)});
+  // Generated characters: poles, a boundary loop, triangles next to quads (Loop: valences 3-8),
+  // an infinitely sharp ridge and a semi-sharp one.
+  shapes.push_back({"own_creature", testing::creature(4)});
+  shapes.push_back({"own_creature_loop", testing::loopCreature(4)});
   return shapes;
 }
 
@@ -198,60 +202,66 @@ TEST_P(EveryShape, MasksRefineAsOpenSubdivVertexForVertex) {
   }
 }
 
-// ---- Quad levels (halfedges, parallel) = the Topology path = OpenSubdiv ----
+// ---- Halfedge levels (quads, triangles; parallel) = the Topology path = OpenSubdiv ----
 
-// Every level the quad path reaches: the same faces, points and limits as the Topology path
+// One level the halfedge path reached: the same faces, points and limits as the Topology path
 // (which the tests above hold to OpenSubdiv), so the fast path is held to OpenSubdiv too.
-TEST_P(EveryShape, QuadLevelsRefineAsTheTopologyPath) {
+template <int N>
+void expectSameLevel(const HalfedgeLevel<N>& q, const Level& level, double diagonal, int l) {
+  ASSERT_EQ(q.vertexCount, level.topology.vertexCount) << "level " << l;
+  ASSERT_TRUE(std::equal(q.vert.begin(), q.vert.end(), level.topology.faceVertices.begin(),
+                         level.topology.faceVertices.end()))
+      << "level " << l;
+  ASSERT_TRUE(std::equal(q.edgeVertices.begin(), q.edgeVertices.end(),
+                         level.topology.edgeVertices.begin(), level.topology.edgeVertices.end()))
+      << "level " << l;
+  for (int f = 0; f < q.faceCount(); ++f) {
+    EXPECT_EQ(q.faceHole[f], level.topology.faceHole[f]) << "level " << l << " face " << f;
+  }
+  const double tolerance = 1e-9 * diagonal;
+  const Limit limit = limitOf(level);
+  const HalfedgeLimit halfedgeLimit = limitOfHalfedges(q);
+  for (int v = 0; v < q.vertexCount; ++v) {
+    ASSERT_LE(length(q.points[v] - level.points[v]), tolerance) << "level " << l << " v " << v;
+    ASSERT_LE(length(halfedgeLimit.positions[v] - limit.positions[v]), tolerance)
+        << "level " << l << " vertex " << v;
+    // The same ring start: the same side of a crease or corner, so the same normal.
+    ASSERT_LE(length(halfedgeLimit.normals[v] - limit.normals[v]), 1e-9)
+        << "level " << l << " vertex " << v;
+  }
+  // What the renderer takes from the same pass (floats): the refined point, its limit, and
+  // the limit normal, turned to its faces' side where it pointed away.
+  std::vector<Vec3f> drawn(q.vertexCount), drawnLimit(q.vertexCount), drawnNormal(q.vertexCount);
+  drawnVertices(q, false, drawn.data(), drawnLimit.data(), drawnNormal.data());
+  const double floatTolerance = 1e-6 * diagonal + 1e-6;
+  for (int v = 0; v < q.vertexCount; ++v) {
+    ASSERT_LE(length(drawn[v].toDouble() - level.points[v]), floatTolerance) << "v " << v;
+    ASSERT_LE(length(drawnLimit[v].toDouble() - limit.positions[v]), floatTolerance)
+        << "level " << l << " vertex " << v;
+    if (length(limit.normals[v]) == 0) continue;
+    ASSERT_GE(std::abs(dot(drawnNormal[v].toDouble(), limit.normals[v])), 1 - 1e-6)
+        << "level " << l << " vertex " << v;
+  }
+}
+
+TEST_P(EveryShape, HalfedgeLevelsRefineAsTheTopologyPath) {
   const Shape& shape = GetParam();
   std::string whyNot;
   std::optional<Level> level = base(shape, whyNot);
   if (!level) GTEST_SKIP() << shape.name << " skipped: " << whyNot;
-  if (shape.mesh.scheme != Scheme::CatmullClark) GTEST_SKIP() << "the quad path is Catmull-Clark's";
-  const double tolerance = 1e-9 * shape.mesh.bounds().diagonal();
-  int quadLevels = 0;
+  const double diagonal = shape.mesh.bounds().diagonal();
+  int halfedgeLevels = 0;
   for (int l = 1; l <= kMaxLevel; ++l) {
     *level = refine(*level, Method::Masks);
     FastRefinement fast = refineUniformFast(shape.mesh, l);
-    if (!fast.quads) continue;
-    ++quadLevels;
-    const QuadLevel& q = *fast.quads;
-    ASSERT_EQ(q.vertexCount, level->topology.vertexCount) << "level " << l;
-    ASSERT_TRUE(std::equal(q.vert.begin(), q.vert.end(), level->topology.faceVertices.begin(),
-                           level->topology.faceVertices.end()))
-        << "level " << l;
-    ASSERT_TRUE(std::equal(q.edgeVertices.begin(), q.edgeVertices.end(),
-                           level->topology.edgeVertices.begin(),
-                           level->topology.edgeVertices.end()))
-        << "level " << l;
-    for (int f = 0; f < q.faceCount(); ++f) {
-      EXPECT_EQ(q.faceHole[f], level->topology.faceHole[f]) << "level " << l << " face " << f;
-    }
-    const Limit limit = limitOf(*level);
-    const QuadLimit quadLimit = limitOfQuads(q);
-    for (int v = 0; v < q.vertexCount; ++v) {
-      ASSERT_LE(length(q.points[v] - level->points[v]), tolerance) << "level " << l << " v " << v;
-      ASSERT_LE(length(quadLimit.positions[v] - limit.positions[v]), tolerance)
-          << "level " << l << " vertex " << v;
-      // The same ring start: the same side of a crease or corner, so the same normal.
-      ASSERT_LE(length(quadLimit.normals[v] - limit.normals[v]), 1e-9)
-          << "level " << l << " vertex " << v;
-    }
-    // What the renderer takes from the same pass (floats): the refined point, its limit, and
-    // the limit normal, turned to its faces' side where it pointed away.
-    std::vector<Vec3f> drawn(q.vertexCount), drawnLimit(q.vertexCount), drawnNormal(q.vertexCount);
-    drawnVertices(q, false, drawn.data(), drawnLimit.data(), drawnNormal.data());
-    const double floatTolerance = 1e-6 * shape.mesh.bounds().diagonal() + 1e-6;
-    for (int v = 0; v < q.vertexCount; ++v) {
-      ASSERT_LE(length(drawn[v].toDouble() - level->points[v]), floatTolerance) << "v " << v;
-      ASSERT_LE(length(drawnLimit[v].toDouble() - limit.positions[v]), floatTolerance)
-          << "level " << l << " vertex " << v;
-      if (length(limit.normals[v]) == 0) continue;
-      ASSERT_GE(std::abs(dot(drawnNormal[v].toDouble(), limit.normals[v])), 1 - 1e-6)
-          << "level " << l << " vertex " << v;
-    }
+    ASSERT_FALSE(fast.quads && shape.mesh.scheme != Scheme::CatmullClark);
+    ASSERT_FALSE(fast.triangles && shape.mesh.scheme != Scheme::Loop);
+    if (fast.quads) expectSameLevel(*fast.quads, *level, diagonal, l);
+    if (fast.triangles) expectSameLevel(*fast.triangles, *level, diagonal, l);
+    if (HasFatalFailure()) return;
+    halfedgeLevels += fast.quads || fast.triangles ? 1 : 0;
   }
-  RecordProperty("quadLevels", quadLevels);
+  RecordProperty("halfedgeLevels", halfedgeLevels);
 }
 
 // ---- Limit masks = OpenSubdiv's PrimvarRefiner::Limit ----

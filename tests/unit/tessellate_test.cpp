@@ -134,11 +134,14 @@ bool sameMesh(const TriangleMesh& a, const TriangleMesh& b) {
 }
 
 // The refinement's loops write every element from one task: one thread and two draw the same
-// mesh bit for bit (quads with holes, a boundary, triangles, creases; and Loop's Topology path).
+// mesh bit for bit (quads and Loop's triangles on halfedges with holes, a boundary, creases,
+// after their first levels on the Topology path).
 TEST(Uniform, OneThreadAndTwoDrawTheSameMesh) {
   mesh::ControlMesh creature = testing::creature(10);
   creature.holes = {3, 40, 41};
-  for (const mesh::ControlMesh& cage : {creature, testing::icosahedron()}) {
+  mesh::ControlMesh loopCreature = testing::loopCreature(8);
+  loopCreature.holes = {5, 70, 71};
+  for (const mesh::ControlMesh& cage : {creature, loopCreature, testing::icosahedron()}) {
     subdiv::LimitSurface surface(cage);
     for (UniformEngine engine : {UniformEngine::Auto, UniformEngine::Masks}) {
       UniformOptions options;
@@ -163,8 +166,9 @@ TriangleMesh drawnBy(const mesh::ControlMesh& cage, UniformEngine engine, int le
   return tessellateUniform(surface, options);
 }
 
-// "auto" takes limn's masks where they take the mesh and OpenSubdiv elsewhere: a non-manifold
-// mesh (three quads on one edge) is drawn, as OpenSubdiv draws it, not refused.
+// "auto" takes limn's masks where they take the mesh (Catmull-Clark and Loop) and OpenSubdiv
+// elsewhere: a non-manifold mesh (three quads on one edge) is drawn, as OpenSubdiv draws it,
+// not refused.
 TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
   mesh::ControlMesh fin;
   fin.points = {{0, 0, 0},    {1, 0, 0},    {0, 1, 0},   {1, 1, 0},
@@ -172,10 +176,11 @@ TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
   testing::addFace(fin, {0, 1, 3, 2});
   testing::addFace(fin, {1, 0, 4, 5});
   testing::addFace(fin, {0, 1, 7, 6});
-  for (const mesh::ControlMesh& cage : {fin, testing::icosahedron()}) {
-    EXPECT_TRUE(
-        sameMesh(drawnBy(cage, UniformEngine::Auto), drawnBy(cage, UniformEngine::OpenSubdiv)));
-  }
+  EXPECT_TRUE(sameMesh(drawnBy(fin, UniformEngine::Auto), drawnBy(fin, UniformEngine::OpenSubdiv)));
+  mesh::ControlMesh bilinear = testing::cube();
+  bilinear.scheme = mesh::Scheme::Bilinear;
+  EXPECT_TRUE(sameMesh(drawnBy(bilinear, UniformEngine::Auto),
+                       drawnBy(bilinear, UniformEngine::OpenSubdiv)));
   // A vertex in no face stays where it is, without a normal, in both engines.
   mesh::ControlMesh loose = testing::cube();
   loose.points.push_back({3, 3, 3});
@@ -185,8 +190,9 @@ TEST(Uniform, AutoFallsBackToOpenSubdivWhereTheRulesCannot) {
   EXPECT_EQ(length(autoLoose.positions[8].toDouble() - Vec3{3, 3, 3}), 0.0);
   EXPECT_EQ(autoLoose.indices, farLoose.indices);
 
-  EXPECT_TRUE(sameMesh(drawnBy(testing::torus(), UniformEngine::Auto),
-                       drawnBy(testing::torus(), UniformEngine::Masks)));
+  for (const mesh::ControlMesh& cage : {testing::torus(), testing::loopCreature(6)}) {
+    EXPECT_TRUE(sameMesh(drawnBy(cage, UniformEngine::Auto), drawnBy(cage, UniformEngine::Masks)));
+  }
 }
 
 TEST(Uniform, PushToLimitMovesEveryVertexToItsLimit) {

@@ -482,4 +482,22 @@ inline ControlMesh creature(int n) {
   return m;
 }
 
+// creature(n) for Loop's scheme: every face fanned into triangles from its first corner (so a
+// quad's diagonal runs from its first corner; the creases are edges of both), which leaves
+// vertices of valence 4 to 8 and the cube's poles at 3 to 6, like a triangulated scan.
+inline ControlMesh loopCreature(int n) {
+  const ControlMesh quads = creature(n);
+  ControlMesh m = quads;
+  m.scheme = Scheme::Loop;
+  m.faceVertexCounts.clear();
+  m.faceVertexIndices.clear();
+  for (int f = 0, first = 0; f < quads.faceCount(); first += quads.faceVertexCounts[f++]) {
+    const int* corner = quads.faceVertexIndices.data() + first;
+    for (int k = 1; k + 1 < quads.faceVertexCounts[f]; ++k) {
+      addFace(m, {corner[0], corner[k], corner[k + 1]});
+    }
+  }
+  return m;
+}
+
 }  // namespace limn::testing
