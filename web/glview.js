@@ -32,10 +32,13 @@ void main() {
   vec3 n = uFlat ? normalize(cross(dFdx(vPosition), dFdy(vPosition))) : normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
   float ndotv = dot(n, toEye);
-  // Flat: the screen-space normal faces the eye; the winding says front or back, as in limn.
-  if (uFlat) ndotv = gl_FrontFacing ? abs(ndotv) : -abs(ndotv);
-  vec3 albedo = ndotv >= 0.0 ? vec3(${FRONT}) : vec3(${BACK});
-  float c = abs(ndotv);
+  // The winding says front or back, as in limn's rasteriser (render/raster/shaders.cpp): a
+  // smooth normal turned a little away near the outline must not paint a back-coloured fringe.
+  // Flat: the screen-space normal faces the eye.
+  if (uFlat) ndotv = abs(ndotv);
+  else if (!gl_FrontFacing) ndotv = -ndotv;
+  vec3 albedo = gl_FrontFacing ? vec3(${FRONT}) : vec3(${BACK});
+  float c = max(ndotv, 0.0);
   vec3 rgb = albedo * (${AMBIENT} + ${DIFFUSE} * c) + ${SPECULAR} * pow(c, ${SHININESS.toFixed(1)});
   color = vec4(clamp(rgb, 0.0, 1.0), 1.0);
 }`;

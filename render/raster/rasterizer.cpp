@@ -43,6 +43,10 @@ constexpr double kOverlayBiasPx = 1.0;
 // slope per pixel: lines lying on a surface still pass the depth test a line half-width
 // (1 px, up to sqrt(2) times the slope diagonally) to either side of their centre.
 constexpr float kSurfaceOffset = -2.0f;
+// How much further back-facing triangles are pushed, in the same units: where a front face and
+// a back face meet at the outline of a closed surface their depths tie or nearly tie, and the
+// back face must not win (it would show the back albedo along the outline).
+constexpr float kBackFaceOffset = -2.0f;
 
 std::string glString(GLenum name) {
   const GLubyte* text = glGetString(name);
@@ -120,6 +124,7 @@ struct Rasterizer::Impl {
   void renderFrame(const Camera& camera, const PassSelection& passes, Shading shading,
                    const std::vector<LineOverlay>& overlays, const CancelToken& cancel,
                    ImageSet& out);
+  void drawSurface(bool offsetSurface);
   void setLineUniforms(const Camera& camera);
   void renderCoverage(const Camera& camera, int supersample, const CancelToken& cancel,
                       ImageSet& out);
@@ -137,7 +142,8 @@ Rasterizer::Impl::Impl() {
   coverageTileSize = std::min(largest, kCoverageTileCap);
 
   // Fixed state for all passes: reversed float depth (see tiling.h), no dithering, no
-  // multisampling, no culling (back faces are drawn and shaded with the back albedo).
+  // multisampling, no culling (back faces are drawn, after the front faces, and shaded with
+  // the back albedo; drawSurface() culls each side in turn).
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glDisable(GL_DITHER);
   glDisable(GL_MULTISAMPLE);
@@ -153,6 +159,23 @@ Rasterizer::Impl::~Impl() {
   } catch (const std::exception&) {
     // Nothing to do: without the context its objects go with it.
   }
+}
+
+void Rasterizer::Impl::drawSurface(bool offsetSurface) {
+  // Front faces, then back faces pushed back a little, so that back faces lose depth ties.
+  // When lines are drawn over it the whole surface is pushed back too, so that edges lying on
+  // it pass the depth test while edges behind other surfaces still fail it.
+  const float front = offsetSurface ? kSurfaceOffset : 0.0f;
+  glEnable(GL_CULL_FACE);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glCullFace(GL_BACK);
+  glPolygonOffset(front, front);
+  mesh.drawTriangles();
+  glCullFace(GL_FRONT);
+  glPolygonOffset(front + kBackFaceOffset, front + kBackFaceOffset);
+  mesh.drawTriangles();
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  glDisable(GL_CULL_FACE);
 }
 
 void Rasterizer::Impl::setLineUniforms(const Camera& camera) {
@@ -217,16 +240,9 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
-    if (offsetSurface) {
-      // Push the surface back a little so edges lying on it pass the depth test, while edges
-      // behind other surfaces still fail it.
-      glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(kSurfaceOffset, kSurfaceOffset);
-    }
     surfaceProgram.use();
     surfaceProgram.setMatrix("uViewProjection", tileViewProjection);
-    mesh.drawTriangles();
-    glDisable(GL_POLYGON_OFFSET_FILL);
+    drawSurface(offsetSurface);
     checkGl("drawing the surface");
 
     if (colorBuffer) {

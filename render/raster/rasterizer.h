@@ -8,7 +8,9 @@
 //
 // What render() draws: every pass is point-sampled at pixel centres (no anti-aliasing), row 0
 // at the top. Geometry outside the camera's near/far planes is clipped. Colour follows
-// shading::shade() (back faces get the back albedo); the normal pass holds the shading normal
+// shading::shade(), the side being the triangle's winding (back faces get the back albedo; a
+// smooth normal that turns away on a front face gets no light), and back faces are drawn
+// behind front faces where their depths tie; the normal pass holds the shading normal
 // as computed (not flipped for back faces); depth is linear (Camera::depthOf), 0 where empty.
 // Line overlays (render/core/overlay.h) each make one more pass: the colour image with the
 // overlay's segments drawn over it, 2 px wide with square ends, composited with their alpha.

@@ -94,11 +94,15 @@ void main() {
     if (mappedLength > 0.0) n = mapped / mappedLength;
   }
 
-  // shading::shade(): headlight Blinn-Phong, the half vector is toEye.
+  // shading::shade(): headlight Blinn-Phong, the half vector is toEye. The side the pixel sees
+  // is the triangle's (its winding), not the interpolated normal's: near the outline of a
+  // tessellation the smooth normal of a front-facing triangle turns a little away from the eye
+  // (it is the limit surface's, whose outline lies elsewhere), and taking its side would paint
+  // a fringe with the back albedo. There the light falls to zero, as at the limit's outline.
   float ndotv = dot(n, toEye);
   vec3 front = vAlbedo.x >= 0.0 ? vAlbedo : kFrontAlbedo;
-  vec3 albedo = ndotv >= 0.0 ? front : kBackAlbedo;
-  float c = abs(ndotv);
+  vec3 albedo = gl_FrontFacing ? front : kBackAlbedo;
+  float c = max(gl_FrontFacing ? ndotv : -ndotv, 0.0);
   float spec = pow(c, kShininess);
   vec3 rgb = clamp(albedo * (kAmbient + kDiffuse * c) + kSpecular * spec, 0.0, 1.0);
 
