@@ -228,6 +228,20 @@ void inheritFromParent(const HalfedgeLevel<N>& p, int innerEdges, int edgePoint0
   });
 }
 
+// The point of every parent edge: its midpoint where it is sharp or on a boundary, else
+// `smooth(ends, first, other)`, with ends the sum of its two ends and first and other its
+// halfedges in its two faces.
+template <int N, typename Smooth>
+void edgePoints(const HalfedgeLevel<N>& p, Vec3* edgePoint, Smooth smooth) {
+  parallelFor(p.edgeCount(), kParallelGrain, [&](size_t begin, size_t end) {
+    for (size_t e = begin; e < end; ++e) {
+      const Vec3 ends = p.points[p.edgeVertices[e][0]] + p.points[p.edgeVertices[e][1]];
+      const int first = p.edgeFirst[e], other = p.twin[first];
+      edgePoint[e] = p.edgeSharp[e] || other < 0 ? 0.5 * ends : smooth(ends, first, other);
+    }
+  });
+}
+
 }  // namespace
 
 int halfedgeCorners(const Topology& t) {
@@ -370,17 +384,9 @@ QuadLevel refineQuads(const QuadLevel& p) {
       facePoint[f] = 0.25 * (p.points[fv[0]] + p.points[fv[1]] + p.points[fv[2]] + p.points[fv[3]]);
     }
   });
-  parallelFor(E, kParallelGrain, [&](size_t begin, size_t end) {
-    for (size_t e = begin; e < end; ++e) {
-      const Vec3 ends = p.points[p.edgeVertices[e][0]] + p.points[p.edgeVertices[e][1]];
-      const int first = p.edgeFirst[e], other = p.twin[first];
-      if (p.edgeSharp[e] || other < 0) {
-        edgePoint[e] = 0.5 * ends;
-      } else {
-        edgePoint[e] = 0.25 * ends + 0.25 * (facePoint[faceOfHalfedge<4>(first)] +
-                                             facePoint[faceOfHalfedge<4>(other)]);
-      }
-    }
+  edgePoints(p, edgePoint, [&](const Vec3& ends, int first, int other) {
+    return 0.25 * ends +
+           0.25 * (facePoint[faceOfHalfedge<4>(first)] + facePoint[faceOfHalfedge<4>(other)]);
   });
   parallelFor(V, kParallelGrain, [&](size_t begin, size_t end) {
     for (size_t v = begin; v < end; ++v) c.points[v] = vertexPoint(p, facePoint, v);
@@ -447,17 +453,10 @@ TriangleLevel refineTriangles(const TriangleLevel& p) {
   // Points: edge points, then vertex points (Loop's read only the parent's points).
   c.points.resize(c.vertexCount);
   Vec3* edgePoint = c.points.data() + edgePoint0;
-  parallelFor(E, kParallelGrain, [&](size_t begin, size_t end) {
-    for (size_t e = begin; e < end; ++e) {
-      const Vec3 ends = p.points[p.edgeVertices[e][0]] + p.points[p.edgeVertices[e][1]];
-      const int first = p.edgeFirst[e], other = p.twin[first];
-      if (p.edgeSharp[e] || other < 0) {
-        edgePoint[e] = 0.5 * ends;
-      } else {  // 3/8 of each end, 1/8 of the corner opposite the edge in each triangle
-        edgePoint[e] = 0.375 * ends + 0.125 * (p.points[p.vert[prevHalfedge<3>(first)]] +
-                                               p.points[p.vert[prevHalfedge<3>(other)]]);
-      }
-    }
+  edgePoints(p, edgePoint, [&](const Vec3& ends, int first, int other) {
+    // 3/8 of each end, 1/8 of the corner opposite the edge in each triangle.
+    return 0.375 * ends + 0.125 * (p.points[p.vert[prevHalfedge<3>(first)]] +
+                                   p.points[p.vert[prevHalfedge<3>(other)]]);
   });
   parallelFor(V, kParallelGrain, [&](size_t begin, size_t end) {
     for (size_t v = begin; v < end; ++v) c.points[v] = vertexPoint(p, v);
