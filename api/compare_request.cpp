@@ -170,7 +170,7 @@ CompareRequest parseDocument(const Value& root, const JobLimits& limits,
   render::pipeline::CompareJob& job = request.job;
   request::warnUnknownFields(root, "",
                              {"mesh", "camera", "cameras", "methods", "metricSupersample",
-                              "outputs", "imageFormat", "displacement"},
+                              "outputs", "antialias", "imageFormat", "displacement"},
                              request.warnings);
   parseCameras(root, limits, request);
   const Value* methods = json::find(root, "methods");
@@ -194,6 +194,9 @@ CompareRequest parseDocument(const Value& root, const JobLimits& limits,
     }
   }
   if (const Value* v = json::find(root, "outputs")) job.outputs = request::parseOutputs(*v);
+  if (const Value* v = json::find(root, "antialias")) {
+    job.outputs.antialias = request::parseAntialias(*v);
+  }
   if (job.outputs.contours &&
       std::none_of(job.methods.begin(), job.methods.end(),
                    [](const CompareMethod& m) { return m.method == Method::Silhouette; })) {

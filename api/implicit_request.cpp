@@ -179,8 +179,8 @@ ImplicitRequest parseImplicitRequest(std::string_view body,
   std::vector<std::string>& warnings = request.warnings;
   render::pipeline::ImplicitJob& job = request.job;
   request::warnUnknownFields(root, "",
-                             {"field", "polygonizer", "camera", "shading", "outputs", "reference",
-                              "imageFormat", "params"},
+                             {"field", "polygonizer", "camera", "shading", "outputs", "antialias",
+                              "reference", "imageFormat", "params"},
                              warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
@@ -190,6 +190,9 @@ ImplicitRequest parseImplicitRequest(std::string_view body,
   }
   if (const Value* v = json::find(root, "shading")) job.shading = request::parseShading(*v);
   if (const Value* v = json::find(root, "outputs")) job.outputs = request::parseOutputs(*v);
+  if (const Value* v = json::find(root, "antialias")) {
+    job.outputs.antialias = request::parseAntialias(*v);
+  }
   if (job.outputs.contours || job.outputs.cage) {
     json::fail("outputs",
                "outputs \"contours\" and \"cage\" belong to subdivision meshes; an "

@@ -283,8 +283,8 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   std::vector<std::string>& warnings = request.warnings;
   render::pipeline::RenderJob& job = request.job;
   warnUnknownFields(root, "",
-                    {"mesh", "camera", "method", "params", "shading", "outputs", "reference",
-                     "imageFormat", "frames", "displacement"},
+                    {"mesh", "camera", "method", "params", "shading", "outputs", "antialias",
+                     "reference", "imageFormat", "frames", "displacement"},
                     warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
@@ -293,6 +293,9 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   if (const Value* v = json::find(root, "params")) job.params = parseParams(*v, limits, warnings);
   if (const Value* v = json::find(root, "shading")) job.shading = request::parseShading(*v);
   if (const Value* v = json::find(root, "outputs")) job.outputs = readOutputs(*v);
+  if (const Value* v = json::find(root, "antialias")) {
+    job.outputs.antialias = request::parseAntialias(*v);
+  }
   if (job.outputs.contours && job.method != Method::Silhouette) {
     json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
   }
@@ -399,6 +402,15 @@ render::Shading parseShading(const Value& shading) {
                                        {{"flat", render::Shading::Flat},
                                         {"smooth", render::Shading::Smooth},
                                         {"normal-map", render::Shading::NormalMap}});
+}
+
+int parseAntialias(const Value& antialias) {
+  const int samples = json::integer(antialias, "antialias");
+  if (samples != 1 && samples != 4 && samples != 8 && samples != 16) {
+    json::fail("antialias",
+               "antialias must be 1, 4, 8 or 16 samples per pixel, got " + std::to_string(samples));
+  }
+  return samples;
 }
 
 render::image::Format parseImageFormat(const Value& format) {

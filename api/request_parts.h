@@ -88,4 +88,7 @@ render::Shading parseShading(const rapidjson::Value& shading);
 // "imageFormat": "png" | "exr".
 render::image::Format parseImageFormat(const rapidjson::Value& format);
 
+// "antialias": samples per pixel of the colour outputs, 1, 4, 8 or 16 (400 naming it otherwise).
+int parseAntialias(const rapidjson::Value& antialias);
+
 }  // namespace limn::api::request

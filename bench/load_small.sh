@@ -2,8 +2,9 @@
 # Throughput of small requests: a cube at 256^2, method adaptive (dicingRate 2), colour only, no
 # reference, from 8 concurrent clients for 20 s (hey, from Debian), against a limn server this
 # script starts on a free loopback port and stops afterwards. Prints hey's summary.
+# ANTIALIAS=N sets the request's "antialias" (default: the server's, 4).
 #
-#   bench/load_small.sh [DURATION] [CLIENTS] [extra limn serve flags...]
+#   [ANTIALIAS=N] bench/load_small.sh [DURATION] [CLIENTS] [extra limn serve flags...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 duration="${1:-20s}"
@@ -21,6 +22,9 @@ cat > "$body" <<'JSON'
  "camera": {"width": 256, "height": 256}, "method": "adaptive", "params": {"dicingRate": 2},
  "outputs": ["color"]}
 JSON
+if [ -n "${ANTIALIAS:-}" ]; then
+  sed -i "s/\"outputs\": \[\"color\"\]/\"outputs\": [\"color\"], \"antialias\": $ANTIALIAS/" "$body"
+fi
 curl -sf -X POST --data-binary @"$body" "127.0.0.1:$port/v1/render" | python3 -c \
   'import json,sys; t=json.load(sys.stdin)["timings"]; print("one request:", {k: round(v, 2) for k, v in t.items() if isinstance(v, float)})'
 hey -z "$duration" -c "$clients" -m POST -T application/json -D "$body" \

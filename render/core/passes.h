@@ -10,6 +10,10 @@ struct PassSelection {
   bool normal = false;
   bool wireframe = false;  // colour with the mesh's edges drawn over it
   int supersample = 0;     // > 0: also fill ImageSet::supersampledMask at this factor
+  // Samples per pixel of the colour-like passes (colour, wireframe, line overlays): 1 is one
+  // sample at the pixel centre; 4, 8 or 16 are averaged over the pixel (anti-aliased). The mask,
+  // depth and normal passes are one sample at the pixel centre either way.
+  int antialias = 1;
 };
 
 enum class Shading {

@@ -204,10 +204,9 @@ std::vector<Bounds> positiveBoxes(const implicit::Field& field) {
   return boxes;
 }
 
-// The hit of pixel (x, y) in double precision on its own ray, around Embree's t.
-SurfaceHit exactHit(implicit::FieldEvaluator& f, const Camera& camera, int x, int y, double t,
-                    double bracket, double tolerance) {
-  const PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
+// The hit of a pixel's ray in double precision, around Embree's t.
+SurfaceHit exactHit(implicit::FieldEvaluator& f, const PixelRay& ray, double t, double bracket,
+                    double tolerance) {
   const Vec3 o = ray.origin, d = ray.direction;
   double t0 = std::max(ray.tNear, t - bracket), t1 = t + bracket;
   const double f0 = f.value(o + d * t0), f1 = f.value(o + d * t1);
@@ -267,7 +266,8 @@ ReferenceResult renderImplicitReference(const implicit::Field& field, const Came
       for (int x = 0; x < width; ++x) {
         const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
         if (!h.hit()) continue;
-        SurfaceHit hit = exactHit(f, camera, x, y, h.t, 1e-5 * diagonal, 1e-9 * diagonal);
+        SurfaceHit hit =
+            exactHit(f, pixelRay(camera, x + 0.5, y + 0.5), h.t, 1e-5 * diagonal, 1e-9 * diagonal);
         ++covered;
         unrefined += !hit.refined;
         images.write(x, y, hit, camera);
@@ -277,6 +277,14 @@ ReferenceResult renderImplicitReference(const implicit::Field& field, const Came
   if (cancelled) throw Cancelled();
   stats.hits = covered;
   stats.newtonFailures = unrefined;
+  if ((passes.color || passes.wireframe) && options.colorSamples.size() > 1) {
+    antialiasEdges(
+        scene.get(), camera, hits, options.colorSamples, cancel,
+        [&](const PixelRay& ray, const PixelHit& h) {
+          return exactHit(data.evaluators.local(), ray, h.t, 1e-5 * diagonal, 1e-9 * diagonal);
+        },
+        result.images.passes.at(pass::kColor), stats);
+  }
   stats.newtonMs = msSince(start);
   colorAsWireframe(passes, "isosurface", result);
 

@@ -210,6 +210,33 @@ uint32_t occludedLanes(RTCScene scene, const Camera& camera, const Vec2* points,
 
 }  // namespace
 
+void castClosestHitsAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
+                       std::vector<PixelHit>& hits, const CancelToken& cancel) {
+  hits.assign(points.size(), PixelHit{});
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, points.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
+          cancelled = true;
+          return;
+        }
+        FlushDenormalsScope ftz;
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          const PixelRay ray = pixelRay(camera, points[i].x, points[i].y);
+          RTCRayHit rayhit;
+          setRay(rayhit.ray, ray);
+          rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(scene, &context, &rayhit);
+          if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          hits[i] = {rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, ray.tNear + rayhit.ray.tfar};
+        }
+      });
+  if (cancelled) throw Cancelled();
+}
+
 void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
                     std::vector<char>& covered, const CancelToken& cancel) {
   covered.assign(points.size(), 0);

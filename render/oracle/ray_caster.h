@@ -42,6 +42,12 @@ struct PixelHit {
 std::vector<PixelHit> castClosestHits(RTCScene scene, const Camera& camera, RayPacking packing,
                                       const CancelToken& cancel);
 
+// Closest hits at arbitrary image-plane points of `camera` (output pixels, x right, y down), one
+// per point, t along pixelRay(camera, point); all threads. For the few rays of anti-aliased
+// outline pixels: single rays, not packets.
+void castClosestHitsAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
+                       std::vector<PixelHit>& hits, const CancelToken& cancel);
+
 // Coverage of all pixels of `camera`: 1 where the ray hits anything, else 0 (occlusion rays,
 // cheaper than closest hits).
 Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,

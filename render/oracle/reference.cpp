@@ -32,14 +32,24 @@ double msSince(Clock::time_point start) {
 // Newton stops when the point is this close to the ray, relative to the model's size.
 constexpr double kRelativeTolerance = 1e-9;
 
+// A ray's hit on the limit surface, from its hit on the dense tessellation (Newton).
+SurfaceHit limitHit(const subdiv::LimitSurface& surface, const tessellate::TriangleMesh& mesh,
+                    const PixelRay& ray, const PixelHit& h) {
+  const double tolerance = kRelativeTolerance * std::max(surface.bounds().diagonal(), 1e-300);
+  int face;
+  Vec2 uv;
+  return triangleHitUV(surface, mesh, h.primID, h.u, h.v, &face, &uv)
+             ? refineHit(surface, face, uv, ray, h.t, tolerance)
+             : unrefinedHit(surface, face, uv, ray, h.t);
+}
+
 // Moves every primary hit onto the limit surface (Newton) and writes the passes; counts hits
-// and failures into result.stats, and warns about the wireframe and about many failures.
+// and failures into result.stats, and warns about many failures.
 void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
                const tessellate::TriangleMesh& mesh, const std::vector<PixelHit>& hits,
                const PassSelection& passes, const CancelToken& cancel, ReferenceResult& result) {
   const int width = camera.width(), height = camera.height();
   PassImages images(result.images, passes, width, height);
-  const double tolerance = kRelativeTolerance * std::max(surface.bounds().diagonal(), 1e-300);
   std::atomic<size_t> covered{0}, failures{0};
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
@@ -52,12 +62,7 @@ void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
       for (int x = 0; x < width; ++x) {
         const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
         if (!h.hit()) continue;
-        PixelRay ray = pixelRay(camera, x + 0.5, y + 0.5);
-        int face;
-        Vec2 uv;
-        SurfaceHit hit = triangleHitUV(surface, mesh, h.primID, h.u, h.v, &face, &uv)
-                             ? refineHit(surface, face, uv, ray, h.t, tolerance)
-                             : unrefinedHit(surface, face, uv, ray, h.t);
+        SurfaceHit hit = limitHit(surface, mesh, pixelRay(camera, x + 0.5, y + 0.5), h);
         ++rowCovered;
         rowFailures += !hit.refined;
         images.write(x, y, hit, camera);
@@ -70,7 +75,6 @@ void shadeHits(const subdiv::LimitSurface& surface, const Camera& camera,
   ReferenceStats& stats = result.stats;
   stats.hits = covered;
   stats.newtonFailures = failures;
-  colorAsWireframe(passes, "limit surface", result);
   if (stats.hits > 0 && stats.newtonFailures * 1000 > stats.hits) {
     result.warnings.push_back("reference: " + std::to_string(stats.newtonFailures) + " of " +
                               std::to_string(stats.hits) +
@@ -126,6 +130,13 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 
   start = Clock::now();
   shadeHits(surface, camera, mesh, hits, passes, cancel, result);
+  if ((passes.color || passes.wireframe) && options.colorSamples.size() > 1) {
+    antialiasEdges(
+        scene, camera, hits, options.colorSamples, cancel,
+        [&](const PixelRay& ray, const PixelHit& h) { return limitHit(surface, mesh, ray, h); },
+        result.images.passes.at(pass::kColor), stats);
+  }
+  colorAsWireframe(passes, "limit surface", result);
   stats.newtonMs = msSince(start);
 
   if (passes.supersample > 0) {

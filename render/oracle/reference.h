@@ -11,6 +11,7 @@
 // it costs about as much as the reference), and the two masks' disagreement is reported.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -75,6 +76,10 @@ struct ReferenceOptions {
   const std::vector<uint8_t>* hintBlocks = nullptr;
   bool locateOutline = false;            // needs passes.supersample > 0
   ReferenceSceneCache* cache = nullptr;  // where to find and keep the tessellation and BVH
+  // The rasteriser's sample positions for an anti-aliased picture (Rasterizer::samplePositions):
+  // with more than one, the colour of pixels along edges is the mean of rays through them, as
+  // the rasteriser resolves its samples (antialiasEdges in reference_passes.h).
+  std::vector<std::array<float, 2>> colorSamples;
 };
 
 // `passes.supersample` > 0 also fills the supersampled mask. Uses all hardware threads through

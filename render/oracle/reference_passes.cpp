@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -93,6 +94,28 @@ void castSupersampledMask(RTCScene scene, const Camera& camera, const std::vecto
   result.images.supersampledMask =
       castCoverageRefined(scene, camera, s, result.refinedPixels, coverage, cancel);
   result.images.supersample = s;
+}
+
+std::vector<int> edgePixels(const std::vector<PixelHit>& hits, int width, int height) {
+  constexpr double kDepthJump = 0.05;
+  std::vector<int> edges;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
+      bool edge = false;
+      for (int dy = -1; dy <= 1 && !edge; ++dy) {
+        for (int dx = -1; dx <= 1 && !edge; ++dx) {
+          const int u = x + dx, v = y + dy;
+          if (u < 0 || v < 0 || u >= width || v >= height) continue;
+          const PixelHit& g = hits[static_cast<size_t>(v) * width + u];
+          edge = g.hit() != h.hit() ||
+                 (h.hit() && std::fabs(g.t - h.t) > kDepthJump * std::min(g.t, h.t));
+        }
+      }
+      if (edge) edges.push_back(y * width + x);
+    }
+  }
+  return edges;
 }
 
 void colorAsWireframe(const PassSelection& passes, const char* surface, ReferenceResult& result) {

@@ -3,6 +3,10 @@
 // full, and a coverage query on a scene for the outline search.
 #pragma once
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -49,16 +53,67 @@ struct PassImages {
       normal->at(x, y, 2) = static_cast<float>(hit.normal.z);
     }
     if (color) {
-      Vec3 toEye = camera.projection() == Projection::Perspective
-                       ? normalize(camera.eye() - hit.position)
-                       : -camera.forward();
       float rgb[3];
-      shading::shade(hit.normal, toEye, rgb);
+      shadeHit(hit, camera, rgb);
       for (int c = 0; c < 3; ++c) color->at(x, y, c) = rgb[c];
       color->at(x, y, 3) = 1.0f;
     }
   }
+
+  // shading::shade() at a hit, seen from the camera.
+  static void shadeHit(const SurfaceHit& hit, const Camera& camera, float rgb[3]) {
+    const Vec3 toEye = camera.projection() == Projection::Perspective
+                           ? normalize(camera.eye() - hit.position)
+                           : -camera.forward();
+    shading::shade(hit.normal, toEye, rgb);
+  }
 };
+
+// Pixels (row-major indices) where the picture changes abruptly: a hit next to a miss among its
+// 8 neighbours, or two hits more than 5% apart along their rays (one surface over another).
+std::vector<int> edgePixels(const std::vector<PixelHit>& hits, int width, int height);
+
+// The colour pass anti-aliased as the rasteriser's multisampling resolves it (passes.antialias,
+// `samples` its sample positions within the pixel): the pixels of edgePixels() become the mean
+// of one ray per sample, each shaded at surfaceAt(ray, hit) (the ray's hit on the surface, from
+// its hit on the scene) or the background with alpha 0 where it misses. Elsewhere a pixel keeps
+// its centre's colour: inside one triangle a multisampled pixel is shaded once, at its centre.
+template <typename SurfaceAt>
+void antialiasEdges(RTCScene scene, const Camera& camera, const std::vector<PixelHit>& hits,
+                    const std::vector<std::array<float, 2>>& samples, const CancelToken& cancel,
+                    SurfaceAt surfaceAt, Image& color, ReferenceStats& stats) {
+  const int width = camera.width();
+  const std::vector<int> edges = edgePixels(hits, width, camera.height());
+  const size_t n = samples.size();
+  std::vector<Vec2> points;
+  points.reserve(edges.size() * n);
+  for (int p : edges) {
+    for (const auto& s : samples) points.push_back({p % width + s[0], p / width + s[1]});
+  }
+  std::vector<PixelHit> sampleHits;
+  castClosestHitsAt(scene, camera, points, sampleHits, cancel);
+  stats.raysCast += points.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, edges.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t e = r.begin(); e < r.end(); ++e) {
+                        float sum[4] = {0, 0, 0, 0};
+                        for (size_t k = e * n; k < (e + 1) * n; ++k) {
+                          float rgb[3];
+                          const float* value = shading::kBackground;
+                          if (sampleHits[k].hit()) {
+                            const PixelRay ray = pixelRay(camera, points[k].x, points[k].y);
+                            PassImages::shadeHit(surfaceAt(ray, sampleHits[k]), camera, rgb);
+                            value = rgb;
+                            sum[3] += 1.0f;
+                          }
+                          for (int c = 0; c < 3; ++c) sum[c] += value[c];
+                        }
+                        const int x = edges[e] % width, y = edges[e] / width;
+                        for (int c = 0; c < 4; ++c) color.at(x, y, c) = sum[c] / n;
+                      }
+                    });
+  cancel.check();
+}
 
 // Output pixels whose S x S samples must all be cast (see renderReference in reference.h):
 // `refine` (outline candidates known beforehand), those with an 8-neighbour of other coverage,

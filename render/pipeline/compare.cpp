@@ -94,10 +94,12 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
                                 {.maskHint = nullptr,
                                  .hintBlocks = &hint,
                                  .locateOutline = true,
-                                 .cache = context.referenceCache});
+                                 .cache = context.referenceCache,
+                                 .colorSamples = colorSamples(context, job.outputs)});
     ref.referenceMs = clock.lapMs();
     ref.stats = reference.stats;
     ref.warnings = reference.warnings;
+    if (auto fewer = antialiasWarning(context, job.outputs)) ref.warnings.push_back(*fewer);
     cancel.check();
     for (size_t m = 0; m < job.methods.size(); ++m) {
       if (!drawings[m]) continue;

@@ -251,18 +251,33 @@ MethodDrawing rasterizeApproximation(Approximated approx, const MethodChoice& ch
                        .depth = outputs.depth || measured,
                        .normal = outputs.normal || measured,
                        .wireframe = outputs.wireframe,
-                       .supersample = measured ? supersample : 0};
+                       .supersample = measured ? supersample : 0,
+                       .antialias = outputs.antialias};
   if (context.rasterizer == nullptr) throw std::runtime_error("no rasterizer in this context");
   drawing.images = context.rasterizer->render(drawing.approx.mesh, camera, passes, choice.shading,
                                               drawing.approx.overlays, cancel);
   if (drawing.approx.patchImageMesh) {
-    ImageSet patchImage = context.rasterizer->render(*drawing.approx.patchImageMesh, camera,
-                                                     {.color = true}, Shading::Smooth, {}, cancel);
+    ImageSet patchImage = context.rasterizer->render(
+        *drawing.approx.patchImageMesh, camera, {.color = true, .antialias = outputs.antialias},
+        Shading::Smooth, {}, cancel);
     drawing.images.passes[pass::kPatches] = std::move(patchImage.passes.at(pass::kColor));
   }
   drawing.rasterMs = clock.lapMs();
   cancel.check();
   return drawing;
+}
+
+std::vector<std::array<float, 2>> colorSamples(RenderContext& context, const Outputs& outputs) {
+  if (outputs.antialias <= 1 || context.rasterizer == nullptr) return {};
+  return context.rasterizer->samplePositions(outputs.antialias);
+}
+
+std::optional<std::string> antialiasWarning(RenderContext& context, const Outputs& outputs) {
+  if (context.rasterizer == nullptr) return std::nullopt;
+  const int taken = context.rasterizer->samplesTaken(outputs.antialias);
+  if (taken == outputs.antialias) return std::nullopt;
+  return "antialias " + std::to_string(outputs.antialias) + " drawn with " + std::to_string(taken) +
+         " samples per pixel, the most this device's OpenGL takes";
 }
 
 PassSelection referencePasses(bool measured, int supersample) {
@@ -285,6 +300,7 @@ metrics::Metrics measureDrawing(MethodDrawing& drawing, const oracle::ReferenceR
 
 void checkMethod(const MethodChoice& choice, const JobLimits& limits) {
   const MethodParams& p = choice.params;
+  checkAntialias(choice.outputs);
   if (choice.shading == Shading::NormalMap && choice.method != Method::Silhouette &&
       choice.method != Method::Coarse) {
     badParameter("shading",

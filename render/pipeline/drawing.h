@@ -101,6 +101,11 @@ MethodDrawing rasterizeApproximation(Approximated approx, const MethodChoice& ch
 // The passes a reference must cast for a camera: all of them, and the supersampled mask when
 // something is measured against it.
 PassSelection referencePasses(bool measured, int supersample);
+// Where the reference casts its colour rays so that its picture is anti-aliased like the
+// rasteriser's (ReferenceOptions::colorSamples): the rasteriser's sample positions, or none.
+std::vector<std::array<float, 2>> colorSamples(RenderContext& context, const Outputs& outputs);
+// A warning when the device draws fewer samples per pixel than outputs.antialias asks for.
+std::optional<std::string> antialiasWarning(RenderContext& context, const Outputs& outputs);
 
 // Every metric of `drawing` (measured) against `reference` (hinted with its mask, alone or
 // merged with others: oracle::maskBlocks), and the geometric error against the limit surface.

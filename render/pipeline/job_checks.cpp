@@ -56,6 +56,13 @@ void checkSupersampledMasks(const CameraSpec& camera, int supersample, const Job
   }
 }
 
+void checkAntialias(const Outputs& outputs) {
+  const int n = outputs.antialias;
+  if (n != 1 && n != 4 && n != 8 && n != 16) {
+    badParameter("antialias", "must be 1, 4, 8 or 16 samples per pixel, got " + std::to_string(n));
+  }
+}
+
 void checkImageSides(const CameraSpec& camera, const JobLimits& limits) {
   for (const std::optional<int>& side : {camera.width, camera.height}) {
     if (side && (*side < 1 || *side > limits.maxImageSide)) {

@@ -38,6 +38,9 @@ void checkSilhouetteParams(int searchSteps, int curveSamples, const JobLimits& l
 void checkDisplacement(const subdiv::DisplacementSpec& displacement, Method method,
                        const std::string& methodField);
 
+// outputs.antialias: 1, 4, 8 or 16 samples per pixel.
+void checkAntialias(const Outputs& outputs);
+
 // camera.width and camera.height against maxImageSide (LimitExceeded).
 void checkImageSides(const CameraSpec& camera, const JobLimits& limits);
 

@@ -73,6 +73,11 @@ struct Outputs {
   bool cage = false;      // the control mesh's edges drawn over the colour image
   bool diff = false;      // a heat map of the colour difference against the reference
   bool patches = false;   // patches: each pixel coloured by its patch's level and kind
+  // Samples per pixel of the colour-like outputs (colour, wireframe, contours, cage, patches,
+  // and the reference's colour at the same sample positions): 1, 4, 8 or 16. Masks, depth and
+  // normals, and so every metric but the colour difference, are one sample per pixel either way.
+  int antialias = kDefaultAntialias;
+  static constexpr int kDefaultAntialias = 4;
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.

@@ -156,6 +156,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     result.stats.patches = approx.stats.patches;
     result.stats.patchTable = approx.stats.patchTable;
     result.warnings.insert(result.warnings.end(), approx.warnings.begin(), approx.warnings.end());
+    if (auto fewer = antialiasWarning(context, job.outputs)) result.warnings.push_back(*fewer);
     result.timings.approxMs = approx.approxMs;
     result.timings.rasterMs = drawing->rasterMs;
     clock.lapMs();
@@ -167,6 +168,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
         .maskHint = drawing ? &drawing->images.supersampledMask : nullptr,
         .locateOutline = measure,
         .cache = context.referenceCache};
+    options.colorSamples = colorSamples(context, job.outputs);
     oracle::ReferenceResult reference =
         oracle::renderReference(surface, camera, referencePasses(measure, S), cancel, options);
     result.stats.referenceTriangles = reference.stats.triangles;

@@ -4,6 +4,7 @@
 
 #include "render/core/error.h"
 #include "render/oracle/implicit_reference.h"
+#include "render/pipeline/drawing.h"
 #include "render/pipeline/implicit_job.h"
 #include "render/pipeline/job_checks.h"
 #include "render/pipeline/measure.h"
@@ -48,6 +49,7 @@ void checkImplicitJob(const ImplicitJob& job, const JobLimits& limits) {
                  "must be in 1.." + std::to_string(limits.maxSupersample));
   }
   checkImageSides(job.camera, limits);
+  checkAntialias(job.outputs);
   if (job.reference) checkSupersampledMasks(job.camera, job.metricSupersample, limits);
   if (job.outputs.diff && !job.reference) {
     badParameter("outputs", "\"diff\" compares with the reference: it needs \"reference\": true");
@@ -153,10 +155,12 @@ RenderResult runImplicit(const ImplicitJob& job, const JobLimits& limits, Render
                        .depth = job.outputs.depth || job.reference,
                        .normal = job.outputs.normal || job.reference,
                        .wireframe = job.outputs.wireframe,
-                       .supersample = job.reference ? S : 0};
+                       .supersample = job.reference ? S : 0,
+                       .antialias = job.outputs.antialias};
   if (context.rasterizer == nullptr) throw std::runtime_error("no rasterizer in this context");
   result.images = context.rasterizer->render(approx, camera, passes, job.shading, {}, cancel);
   result.timings.rasterMs = clock.lapMs();
+  if (auto fewer = antialiasWarning(context, job.outputs)) result.warnings.push_back(*fewer);
   cancel.check();
 
   if (job.reference) {
@@ -164,6 +168,7 @@ RenderResult runImplicit(const ImplicitJob& job, const JobLimits& limits, Render
         .color = true, .mask = true, .depth = true, .normal = true, .supersample = S};
     oracle::ReferenceOptions options{
         .maskHint = &result.images.supersampledMask, .locateOutline = true, .cache = nullptr};
+    options.colorSamples = colorSamples(context, job.outputs);
     oracle::ReferenceResult reference =
         oracle::renderImplicitReference(field, camera, referencePasses, cancel, options);
     result.warnings.insert(result.warnings.end(), reference.warnings.begin(),

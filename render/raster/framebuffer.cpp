@@ -21,7 +21,7 @@ Framebuffer::~Framebuffer() {
   glDeleteFramebuffers(1, &framebuffer_);
 }
 
-void Framebuffer::allocate(int width, int height) {
+void Framebuffer::allocate(int width, int height, int samples) {
   // Fresh renderbuffers: the old ones go first so that both are never held at once.
   if (!colorBuffers_.empty()) {
     glDeleteRenderbuffers(static_cast<GLsizei>(colorBuffers_.size()), colorBuffers_.data());
@@ -32,27 +32,37 @@ void Framebuffer::allocate(int width, int height) {
   colorBuffers_.assign(colorFormats_.size(), 0);
   glCreateRenderbuffers(static_cast<GLsizei>(colorBuffers_.size()), colorBuffers_.data());
   for (size_t i = 0; i < colorBuffers_.size(); ++i) {
-    glNamedRenderbufferStorage(colorBuffers_[i], colorFormats_[i], width, height);
-    glNamedFramebufferRenderbuffer(framebuffer_, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                                   GL_RENDERBUFFER, colorBuffers_[i]);
+    const GLenum attachment = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i);
+    if (colorFormats_[i] == GL_NONE) {
+      glNamedFramebufferRenderbuffer(framebuffer_, attachment, GL_RENDERBUFFER, 0);
+      continue;
+    }
+    glNamedRenderbufferStorageMultisample(colorBuffers_[i], samples, colorFormats_[i], width,
+                                          height);
+    glNamedFramebufferRenderbuffer(framebuffer_, attachment, GL_RENDERBUFFER, colorBuffers_[i]);
   }
   depthBuffer_ = 0;
   if (withDepth_) {
     glCreateRenderbuffers(1, &depthBuffer_);
-    glNamedRenderbufferStorage(depthBuffer_, GL_DEPTH_COMPONENT32F, width, height);
+    glNamedRenderbufferStorageMultisample(depthBuffer_, samples, GL_DEPTH_COMPONENT32F, width,
+                                          height);
     glNamedFramebufferRenderbuffer(framebuffer_, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
                                    depthBuffer_);
   }
-  const std::string what =
-      "allocating a " + std::to_string(width) + " x " + std::to_string(height) + " framebuffer";
+  const std::string what = "allocating a " + std::to_string(width) + " x " +
+                           std::to_string(height) + " framebuffer of " + std::to_string(samples) +
+                           " samples";
   checkGl(what.c_str());
   checkFramebuffer(framebuffer_, what.c_str());
   width_ = width;
   height_ = height;
+  samples_ = samples;
 }
 
-void Framebuffer::bind(int width, int height) {
-  if (width != width_ || height != height_) allocate(width, height);
+void Framebuffer::bind(int width, int height, int samples) {
+  if (width != width_ || height != height_ || samples != samples_) {
+    allocate(width, height, samples);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
   glViewport(0, 0, width, height);
 }
@@ -72,6 +82,27 @@ void Framebuffer::clearColor(int attachment, const float value[4]) {
 
 void Framebuffer::clearDepth(float value) {
   glClearNamedFramebufferfv(framebuffer_, GL_DEPTH, 0, &value);
+}
+
+void Framebuffer::resolveInto(int attachment, Framebuffer& target, int targetAttachment) const {
+  glNamedFramebufferReadBuffer(framebuffer_,
+                               GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
+  glNamedFramebufferDrawBuffer(target.framebuffer_,
+                               GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(targetAttachment));
+  glBlitNamedFramebuffer(framebuffer_, target.framebuffer_, 0, 0, width_, height_, 0, 0,
+                         target.width_, target.height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  checkGl("resolving a multisampled attachment");
+}
+
+std::vector<std::array<float, 2>> Framebuffer::samplePositions() const {
+  std::vector<std::array<float, 2>> positions(samples_);
+  for (int i = 0; i < samples_; ++i) {
+    GLfloat at[2] = {0.5f, 0.5f};
+    glGetMultisamplefv(GL_SAMPLE_POSITION, static_cast<GLuint>(i), at);
+    positions[i] = {at[0], 1.0f - at[1]};  // OpenGL's y runs up
+  }
+  checkGl("querying the sample positions");
+  return positions;
 }
 
 void Framebuffer::read(int attachment, GLenum format, std::vector<float>& out) const {

@@ -1,6 +1,7 @@
 #include "render/raster/rasterizer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,6 +26,9 @@ namespace {
 // pixel (2048^2: 176 MiB), the coverage pass 1 byte per pixel (4096^2: 16 MiB).
 constexpr int kFrameTileCap = 2048;
 constexpr int kCoverageTileCap = 4096;
+// Samples of one tile of the anti-aliased colour pass (16 bytes each: colour, overlay, depth):
+// 8M, 128 MiB, i.e. 1448^2 at 4 samples per pixel, 1024^2 at 8, 724^2 at 16.
+constexpr double kMultisampleTileSamples = 8 << 20;
 
 // Attachments of the frame pass; fragment output i writes attachment i.
 enum FrameAttachment {
@@ -47,6 +51,11 @@ constexpr float kSurfaceOffset = -2.0f;
 // a back face meet at the outline of a closed surface their depths tie or nearly tie, and the
 // back face must not win (it would show the back albedo along the outline).
 constexpr float kBackFaceOffset = -2.0f;
+
+constexpr float kBackgroundColor[4] = {shading::kBackground[0], shading::kBackground[1],
+                                       shading::kBackground[2], 0.0f};
+constexpr float kWireColor[4] = {shading::kWireColor[0], shading::kWireColor[1],
+                                 shading::kWireColor[2], 1.0f};
 
 std::string glString(GLenum name) {
   const GLubyte* text = glGetString(name);
@@ -112,6 +121,9 @@ struct Rasterizer::Impl {
   NormalTexture normalTexture;
   OverlayBuffers overlayLines;
   Framebuffer frame{{GL_RGBA32F, GL_R32F, GL_RGBA32F, GL_RGBA8}, /*withDepth=*/true};
+  // The anti-aliased colour and overlay (attachments as frame's), and their resolved pixels.
+  Framebuffer multisampled{{GL_RGBA8, GL_NONE, GL_NONE, GL_RGBA8}, /*withDepth=*/true};
+  Framebuffer resolved{{GL_RGBA8, GL_RGBA8}, /*withDepth=*/false};
   Framebuffer coverage{{GL_R8}, /*withDepth=*/false};
   int frameTileSize = 0;
   int coverageTileSize = 0;
@@ -125,6 +137,13 @@ struct Rasterizer::Impl {
                    const std::vector<LineOverlay>& overlays, const CancelToken& cancel,
                    ImageSet& out);
   void drawSurface(bool offsetSurface);
+  void drawSingleSample(const Tile& tile, const PassSelection& passes, bool offsetSurface,
+                        bool colorBuffer, bool antialiased, Image& color, Image& mask, Image& depth,
+                        Image& normal);
+  void drawLines(const LineOverlay& overlay, size_t k, Framebuffer& target);
+  void drawAntialiased(const Tile& tile, const PassSelection& passes, bool offsetSurface,
+                       const std::vector<LineOverlay>& overlays, Image& color, Image& wireframe,
+                       std::vector<Image>& overlayImages);
   void setLineUniforms(const Camera& camera);
   void renderCoverage(const Camera& camera, int supersample, const CancelToken& cancel,
                       ImageSet& out);
@@ -136,6 +155,7 @@ Rasterizer::Impl::Impl() {
   device.version = glString(GL_VERSION);
   device.eglPlatform = context.platform();
   device.maxTextureSize = normalTexture.maxSide();
+  glGetIntegerv(GL_MAX_SAMPLES, &device.maxSamples);
 
   const int largest = largestFramebufferSide();
   frameTileSize = std::min(largest, kFrameTileCap);
@@ -178,6 +198,105 @@ void Rasterizer::Impl::drawSurface(bool offsetSurface) {
   glDisable(GL_CULL_FACE);
 }
 
+void Rasterizer::Impl::drawLines(const LineOverlay& overlay, size_t k, Framebuffer& target) {
+  const float transparent[4] = {0, 0, 0, 0};
+  target.setDrawBuffers({false, false, false, true});
+  target.clearColor(kOverlayAttachment, transparent);
+  if (overlay.occluded) {
+    glEnable(GL_DEPTH_TEST);
+  } else {
+    glDisable(GL_DEPTH_TEST);
+  }
+  lineProgram.use();
+  overlayLines.draw(k);
+  checkGl("drawing an overlay");
+}
+
+// The colour-like passes of one tile, multisampled at passes.antialias samples per pixel and
+// resolved (each pixel the mean of its samples): the surface, each overlay over it, the
+// wireframe. The programs' uniforms for the tile are set.
+void Rasterizer::Impl::drawAntialiased(const Tile& tile, const PassSelection& passes,
+                                       bool offsetSurface, const std::vector<LineOverlay>& overlays,
+                                       Image& color, Image& wireframe,
+                                       std::vector<Image>& overlayImages) {
+  resolved.bind(tile.width, tile.height);  // sized; the draws go to `multisampled`
+  multisampled.bind(tile.width, tile.height, passes.antialias);
+  multisampled.setDrawBuffers({true});
+  multisampled.clearColor(kColorAttachment, kBackgroundColor);
+  multisampled.clearDepth(0.0f);
+  glEnable(GL_MULTISAMPLE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  surfaceProgram.use();
+  drawSurface(offsetSurface);
+  checkGl("drawing the anti-aliased surface");
+  multisampled.resolveInto(kColorAttachment, resolved, 0);
+  resolved.read(0, GL_RGBA, colorReadback);
+  if (passes.color) placeTile(colorReadback, 4, tile, color, copyComponents<4>);
+
+  glDepthMask(GL_FALSE);
+  glDepthFunc(GL_GEQUAL);
+  for (size_t k = 0; k < overlays.size(); ++k) {
+    drawLines(overlays[k], k, multisampled);
+    multisampled.resolveInto(kOverlayAttachment, resolved, 1);
+    resolved.readBytes(1, GL_RGBA, readbackBytes);
+    placeOverlayTile(colorReadback, readbackBytes, tile, overlayImages[k]);
+  }
+  if (passes.wireframe) {
+    multisampled.setDrawBuffers({true});
+    glEnable(GL_DEPTH_TEST);
+    solidProgram.use();
+    mesh.drawEdges();
+    checkGl("drawing the anti-aliased wireframe");
+    multisampled.resolveInto(kColorAttachment, resolved, 0);
+    resolved.read(0, GL_RGBA, readback);
+    placeTile(readback, 4, tile, wireframe, copyComponents<4>);
+  }
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_MULTISAMPLE);
+}
+
+// The passes drawn with one sample per pixel into `frame`: mask, depth, normal, and the colour
+// unless it is anti-aliased (its readback stays in colorReadback for the overlays). The surface
+// program's uniforms for the tile are set.
+void Rasterizer::Impl::drawSingleSample(const Tile& tile, const PassSelection& passes,
+                                        bool offsetSurface, bool colorBuffer, bool antialiased,
+                                        Image& color, Image& mask, Image& depth, Image& normal) {
+  const float zero[4] = {0, 0, 0, 0};
+  frame.bind(tile.width, tile.height);
+  frame.setDrawBuffers({colorBuffer, passes.depth, passes.normal});
+  if (colorBuffer) frame.clearColor(kColorAttachment, kBackgroundColor);
+  if (passes.depth) frame.clearColor(kDepthAttachment, zero);
+  if (passes.normal) frame.clearColor(kNormalAttachment, zero);
+  frame.clearDepth(0.0f);
+
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  surfaceProgram.use();
+  drawSurface(offsetSurface);
+  checkGl("drawing the surface");
+
+  if (colorBuffer) {
+    frame.read(kColorAttachment, GL_RGBA, colorReadback);
+    if (passes.color && !antialiased) placeTile(colorReadback, 4, tile, color, copyComponents<4>);
+    if (passes.mask) {
+      placeTile(colorReadback, 4, tile, mask,
+                [](const float* from, float* to) { *to = from[3] > 0.5f ? 1.0f : 0.0f; });
+    }
+  }
+  if (passes.depth) {
+    frame.read(kDepthAttachment, GL_RED, readback);
+    placeTile(readback, 1, tile, depth, copyComponents<1>);
+  }
+  if (passes.normal) {
+    frame.read(kNormalAttachment, GL_RGBA, readback);
+    placeTile(readback, 4, tile, normal, copyComponents<3>);
+  }
+}
+
 void Rasterizer::Impl::setLineUniforms(const Camera& camera) {
   const bool perspective = camera.projection() == Projection::Perspective;
   const Vec3f eye(camera.eye()), forward(camera.forward());
@@ -196,7 +315,12 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
                                    Shading shading, const std::vector<LineOverlay>& overlays,
                                    const CancelToken& cancel, ImageSet& out) {
   const int width = camera.width(), height = camera.height();
-  const bool colorBuffer = passes.color || passes.mask || passes.wireframe || !overlays.empty();
+  const bool antialiased =
+      passes.antialias > 1 && (passes.color || passes.wireframe || !overlays.empty());
+  // One sample per pixel: the mask, and the colour-like passes unless anti-aliased.
+  const bool colorBuffer =
+      passes.mask || (!antialiased && (passes.color || passes.wireframe || !overlays.empty()));
+  const bool singleSample = colorBuffer || passes.depth || passes.normal;
   Image color, mask, depth, normal, wireframe;
   if (passes.color) color = Image(width, height, 4);
   if (passes.mask) mask = Image(width, height, 1);
@@ -220,86 +344,57 @@ void Rasterizer::Impl::renderFrame(const Camera& camera, const PassSelection& pa
   constexpr GLuint kNormalTextureUnit = 0;
   surfaceProgram.setInt("uNormalTexture", kNormalTextureUnit);
   if (shading == Shading::NormalMap) normalTexture.bind(kNormalTextureUnit);
-  const float wireColor[4] = {shading::kWireColor[0], shading::kWireColor[1],
-                              shading::kWireColor[2], 1.0f};
-  const float background[4] = {shading::kBackground[0], shading::kBackground[1],
-                               shading::kBackground[2], 0.0f};
-  const float zero[4] = {0, 0, 0, 0};
+  const int tileSize =
+      antialiased
+          ? std::min(frameTileSize,
+                     static_cast<int>(std::sqrt(kMultisampleTileSamples / passes.antialias)))
+          : frameTileSize;
 
-  for (const Tile& tile : makeTiles(width, height, frameTileSize)) {
+  for (const Tile& tile : makeTiles(width, height, tileSize)) {
     cancel.check();
     const Mat4 tileViewProjection =
         multiply(tileClipTransform(width, height, tile), viewProjection);
-    frame.bind(tile.width, tile.height);
-    frame.setDrawBuffers({colorBuffer, passes.depth, passes.normal});
-    if (colorBuffer) frame.clearColor(kColorAttachment, background);
-    if (passes.depth) frame.clearColor(kDepthAttachment, zero);
-    if (passes.normal) frame.clearColor(kNormalAttachment, zero);
-    frame.clearDepth(0.0f);
-
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_TRUE);
     surfaceProgram.use();
     surfaceProgram.setMatrix("uViewProjection", tileViewProjection);
-    drawSurface(offsetSurface);
-    checkGl("drawing the surface");
-
-    if (colorBuffer) {
-      frame.read(kColorAttachment, GL_RGBA, colorReadback);
-      if (passes.color) placeTile(colorReadback, 4, tile, color, copyComponents<4>);
-      if (passes.mask) {
-        placeTile(colorReadback, 4, tile, mask,
-                  [](const float* from, float* to) { *to = from[3] > 0.5f ? 1.0f : 0.0f; });
-      }
-    }
-    if (passes.depth) {
-      frame.read(kDepthAttachment, GL_RED, readback);
-      placeTile(readback, 1, tile, depth, copyComponents<1>);
-    }
-    if (passes.normal) {
-      frame.read(kNormalAttachment, GL_RGBA, readback);
-      placeTile(readback, 4, tile, normal, copyComponents<3>);
-    }
+    if (singleSample)
+      drawSingleSample(tile, passes, offsetSurface, colorBuffer, antialiased, color, mask, depth,
+                       normal);
 
     if (!overlays.empty()) {
       lineProgram.use();
       lineProgram.setMatrix("uViewProjection", tileViewProjection);
       lineProgram.setVec2("uViewport", static_cast<float>(tile.width),
                           static_cast<float>(tile.height));
-      glDepthMask(GL_FALSE);
-      glDepthFunc(GL_GEQUAL);
-      const float transparent[4] = {0, 0, 0, 0};
-      for (size_t k = 0; k < overlays.size(); ++k) {
-        frame.setDrawBuffers({false, false, false, true});
-        frame.clearColor(kOverlayAttachment, transparent);
-        if (overlays[k].occluded) {
-          glEnable(GL_DEPTH_TEST);
-        } else {
-          glDisable(GL_DEPTH_TEST);
-        }
-        overlayLines.draw(k);
-        checkGl("drawing an overlay");
-        frame.readBytes(kOverlayAttachment, GL_RGBA, readbackBytes);
-        placeOverlayTile(colorReadback, readbackBytes, tile, overlayImages[k]);
-      }
-      glEnable(GL_DEPTH_TEST);
-      glDepthMask(GL_TRUE);
     }
-
     if (passes.wireframe) {
-      frame.setDrawBuffers({true});
-      glDepthFunc(GL_GEQUAL);
-      glDepthMask(GL_FALSE);
       solidProgram.use();
       solidProgram.setMatrix("uViewProjection", tileViewProjection);
-      solidProgram.setVec4("uColor", wireColor);
+      solidProgram.setVec4("uColor", kWireColor);
+    }
+    if (antialiased) {
+      drawAntialiased(tile, passes, offsetSurface, overlays, color, wireframe, overlayImages);
+      continue;
+    }
+
+    // Lines and edges are tested against the surface's depth without changing it.
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_GEQUAL);
+    for (size_t k = 0; k < overlays.size(); ++k) {
+      drawLines(overlays[k], k, frame);
+      frame.readBytes(kOverlayAttachment, GL_RGBA, readbackBytes);
+      placeOverlayTile(colorReadback, readbackBytes, tile, overlayImages[k]);
+    }
+    if (passes.wireframe) {
+      frame.setDrawBuffers({true});
+      glEnable(GL_DEPTH_TEST);
+      solidProgram.use();
       mesh.drawEdges();
-      glDepthMask(GL_TRUE);
       checkGl("drawing the wireframe");
       frame.read(kColorAttachment, GL_RGBA, readback);
       placeTile(readback, 4, tile, wireframe, copyComponents<4>);
     }
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
   }
   if (passes.color) out.passes[pass::kColor] = std::move(color);
   if (passes.mask) out.passes[pass::kMask] = std::move(mask);
@@ -348,6 +443,19 @@ const DeviceInfo& Rasterizer::device() const { return impl_->device; }
 
 void Rasterizer::makeCurrent() { impl_->context.makeCurrent(); }
 
+int Rasterizer::samplesTaken(int samples) const {
+  return std::clamp(samples, 1, std::max(impl_->device.maxSamples, 1));
+}
+
+std::vector<std::array<float, 2>> Rasterizer::samplePositions(int samples) {
+  impl_->context.makeCurrent();
+  samples = samplesTaken(samples);
+  if (samples == 1) return {{0.5f, 0.5f}};
+  Framebuffer probe({GL_RGBA8}, /*withDepth=*/false);
+  probe.bind(1, 1, samples);
+  return probe.samplePositions();
+}
+
 ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& camera,
                             const PassSelection& passes, Shading shading,
                             const std::vector<LineOverlay>& overlays, const CancelToken& cancel) {
@@ -356,6 +464,10 @@ ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& 
   }
   if (passes.supersample < 0) {
     throw std::invalid_argument("raster: the supersample factor must not be negative");
+  }
+  if (passes.antialias < 1) {
+    throw std::invalid_argument("raster: antialias must be at least 1 sample, got " +
+                                std::to_string(passes.antialias));
   }
   validateOverlays(overlays);
   const bool mapped = shading == Shading::NormalMap;
@@ -372,7 +484,9 @@ ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& 
   impl_->mesh.upload(mesh, mapped);
   if (mapped && frame) impl_->normalTexture.upload(*mesh.normalMap);
   if (!overlays.empty()) impl_->overlayLines.upload(overlays);
-  if (frame) impl_->renderFrame(camera, passes, shading, overlays, cancel, result);
+  PassSelection drawn = passes;
+  drawn.antialias = std::min(passes.antialias, samplesTaken(passes.antialias));
+  if (frame) impl_->renderFrame(camera, drawn, shading, overlays, cancel, result);
   if (passes.supersample > 0) impl_->renderCoverage(camera, passes.supersample, cancel, result);
   return result;
 }

@@ -6,8 +6,10 @@
 // framebuffer objects; no window or display server is involved. Construct it on the thread
 // that will call render(), and destroy it there.
 //
-// What render() draws: every pass is point-sampled at pixel centres (no anti-aliasing), row 0
-// at the top. Geometry outside the camera's near/far planes is clipped. Colour follows
+// What render() draws: every pass is point-sampled at pixel centres, row 0 at the top, except
+// that with passes.antialias > 1 the colour, wireframe and overlay passes are multisampled
+// (MSAA, shaded once per pixel and triangle, covered at each sample) and resolved to the mean
+// of each pixel's samples. Geometry outside the camera's near/far planes is clipped. Colour follows
 // shading::shade(), the side being the triangle's winding (back faces get the back albedo; a
 // smooth normal that turns away on a front face gets no light), and back faces are drawn
 // behind front faces where their depths tie; the normal pass holds the shading normal
@@ -28,6 +30,7 @@
 // std::invalid_argument; GL failures throw std::runtime_error naming the step.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +50,7 @@ struct DeviceInfo {
   std::string version;      // GL_VERSION
   std::string eglPlatform;  // "device" or "surfaceless"
   int maxTextureSize = 0;   // GL_MAX_TEXTURE_SIZE: the largest normal map side it can take
+  int maxSamples = 0;       // GL_MAX_SAMPLES: the most samples per pixel it draws
 };
 
 class Rasterizer {
@@ -60,6 +64,14 @@ class Rasterizer {
   // Makes its context current on the calling thread, for GL work of other modules between
   // renders (the patches' tessellation shaders); render() does it itself.
   void makeCurrent();
+
+  // The samples per pixel render() draws for passes.antialias = `samples`: as many, or the most
+  // the device takes (device().maxSamples; llvmpipe's is 4).
+  int samplesTaken(int samples) const;
+  // Where those samples lie within the pixel: x right, y down, in [0, 1]; the pixel centre for
+  // one. The reference casts its colour rays there, so that both pictures average the same
+  // points.
+  std::vector<std::array<float, 2>> samplePositions(int samples);
 
   // Draws `mesh` for `camera` and returns the selected passes at the camera's size, plus the
   // supersampled coverage mask when passes.supersample > 0, plus one pass per overlay, named

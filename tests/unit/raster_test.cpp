@@ -9,9 +9,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -746,6 +748,148 @@ TEST_F(RasterTest, OverlayLinesInFrontOfASphere) {
   EXPECT_LE(red, 2 * camera.width());
   // The colour pass itself has no line in it.
   EXPECT_FALSE(pixelHasColor(color, 80, static_cast<int>(segments[0].a.y), overlay.colors[0]));
+}
+
+// ---- Anti-aliasing ----
+
+// Pixels of an image whose alpha lies strictly between empty and covered.
+int partialAlphaPixels(const Image& image) {
+  int partial = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      partial += image.at(x, y, 3) > 0.01f && image.at(x, y, 3) < 0.99f;
+  return partial;
+}
+
+// Multisampled colour: the outline's pixels blend surface and background (intermediate alpha
+// and colour), the inside keeps the one-sample colour, and the mask, depth and normal passes
+// (what the metrics read) are exactly the one-sample ones.
+TEST_F(RasterTest, AntialiasingBlendsTheOutlineAndLeavesTheMetricPassesAlone) {
+  const TriangleMesh mesh = sphere(1.0, 48, 64);
+  const Camera camera = sphereCamera();
+  PassSelection passes = allPasses();
+  const ImageSet sharp = rasterizer().render(mesh, camera, passes, Shading::Smooth);
+  EXPECT_EQ(partialAlphaPixels(sharp.passes.at(pass::kColor)), 0);
+  for (int samples : {4, 8, 16}) {
+    if (samples > rasterizer().device().maxSamples) continue;
+    passes.antialias = samples;
+    const ImageSet smooth = rasterizer().render(mesh, camera, passes, Shading::Smooth);
+    const Image& color = smooth.passes.at(pass::kColor);
+    const Image& mask = smooth.passes.at(pass::kMask);
+    for (const char* name : {pass::kMask, pass::kDepth, pass::kNormal}) {
+      EXPECT_EQ(smooth.passes.at(name).pixels, sharp.passes.at(name).pixels) << name << samples;
+    }
+    // Every outline pixel (covered, with an uncovered 4-neighbour, or the reverse) of a sphere
+    // is partly covered; about the outline's length in pixels of them are.
+    int outline = 0, blended = 0, insideDiffers = 0;
+    for (int y = 1; y + 1 < camera.height(); ++y) {
+      for (int x = 1; x + 1 < camera.width(); ++x) {
+        const float m = mask.at(x, y);
+        const bool edge = mask.at(x - 1, y) != m || mask.at(x + 1, y) != m ||
+                          mask.at(x, y - 1) != m || mask.at(x, y + 1) != m;
+        const float alpha = color.at(x, y, 3);
+        if (edge && m > 0) {
+          ++outline;
+          blended += alpha < 0.999f;
+        }
+        if (!edge && m > 0) {
+          EXPECT_EQ(alpha, 1.0f) << x << "," << y;
+          const float one = sharp.passes.at(pass::kColor).at(x, y, 0);
+          insideDiffers += std::fabs(color.at(x, y, 0) - one) > 2.5f / 255;  // 8-bit samples
+        }
+      }
+    }
+    EXPECT_GT(outline, 100);
+    EXPECT_GT(blended, outline / 4) << samples << " samples";  // the others: wholly covered
+    EXPECT_LT(insideDiffers, outline / 4) << "the inside is shaded once per pixel";
+    EXPECT_GT(partialAlphaPixels(color), outline / 2);
+  }
+}
+
+TEST_F(RasterTest, SamplePositionsLieInsideThePixelAndDiffer) {
+  EXPECT_EQ(rasterizer().samplePositions(1), (std::vector<std::array<float, 2>>{{0.5f, 0.5f}}));
+  ASSERT_GE(rasterizer().device().maxSamples, 4) << "llvmpipe and every GPU take 4x MSAA";
+  const auto positions = rasterizer().samplePositions(4);
+  ASSERT_EQ(positions.size(), 4u);
+  std::printf("maxSamples %d; 4x pattern:", rasterizer().device().maxSamples);
+  for (const auto& p : positions) std::printf(" (%.4f, %.4f)", p[0], p[1]);
+  std::printf("\n");
+  for (size_t i = 0; i < positions.size(); ++i) {
+    EXPECT_GE(positions[i][0], 0.0f);
+    EXPECT_LE(positions[i][0], 1.0f);
+    EXPECT_GE(positions[i][1], 0.0f);
+    EXPECT_LE(positions[i][1], 1.0f);
+    for (size_t j = 0; j < i; ++j) EXPECT_NE(positions[i], positions[j]);
+  }
+  // More than the device takes: drawn with as many as it takes.
+  const int most = rasterizer().device().maxSamples;
+  EXPECT_EQ(rasterizer().samplesTaken(most * 2), most);
+  EXPECT_EQ(rasterizer().samplePositions(most * 2).size(), static_cast<size_t>(most));
+  PassSelection tooMany = allPasses();
+  tooMany.antialias = most * 2;
+  PassSelection most4 = allPasses();
+  most4.antialias = most;
+  const Camera camera = perspectiveCamera();
+  EXPECT_EQ(rasterizer()
+                .render(tiltedQuad(), camera, tooMany, Shading::Flat)
+                .passes.at(pass::kColor)
+                .pixels,
+            rasterizer()
+                .render(tiltedQuad(), camera, most4, Shading::Flat)
+                .passes.at(pass::kColor)
+                .pixels);
+  PassSelection none = allPasses();
+  none.antialias = 0;
+  EXPECT_THROW(rasterizer().render(tiltedQuad(), camera, none, Shading::Flat),
+               std::invalid_argument);
+}
+
+// Overlay lines and the wireframe are anti-aliased too: a slanted line's pixels blend into the
+// surface beneath (colours between the line's and the surface's), and with one sample they do not.
+TEST_F(RasterTest, AntialiasedOverlayLinesBlendIntoTheSurface) {
+  const TriangleMesh mesh = sphere(1.0, 48, 64);
+  const Camera camera = sphereCamera();
+  LineOverlay overlay;
+  overlay.pass = "lines";
+  overlay.points = {Vec3f(-0.3f, -2, 1.2f), Vec3f(0.2f, 2, 1.1f)};
+  overlay.colors = {Rgba{250, 10, 20, 255}};
+  // Pixels the line touched (the overlay pass differs from the colour pass): the line's own
+  // colour, or a blend of it and the surface.
+  const auto linePixels = [&](const ImageSet& images) {
+    const Image &lines = images.passes.at("lines"), &color = images.passes.at(pass::kColor);
+    int pure = 0, blended = 0;
+    for (int y = 0; y < lines.height; ++y) {
+      for (int x = 0; x < lines.width; ++x) {
+        double fromColor = 0, fromLine = 0;
+        for (int c = 0; c < 3; ++c) {
+          fromColor += std::fabs(lines.at(x, y, c) - color.at(x, y, c));
+          fromLine += std::fabs(lines.at(x, y, c) - overlay.colors[0][c] / 255.0);
+        }
+        if (fromColor < 0.02) continue;
+        (fromLine < 0.02 ? pure : blended) += 1;
+      }
+    }
+    return std::pair{pure, blended};
+  };
+  PassSelection passes = colorAndMask();
+  passes.wireframe = true;
+  const ImageSet sharp = rasterizer().render(mesh, camera, passes, Shading::Smooth, {overlay});
+  passes.antialias = 4;
+  const ImageSet smooth = rasterizer().render(mesh, camera, passes, Shading::Smooth, {overlay});
+  const auto [sharpPure, sharpBlended] = linePixels(sharp);
+  const auto [pure, blended] = linePixels(smooth);
+  EXPECT_GT(sharpPure, 100);
+  EXPECT_EQ(sharpBlended, 0);
+  EXPECT_GT(blended, sharpPure / 2) << "a slanted line's edge pixels are blended";
+  EXPECT_GT(pure, 0);
+  // The wireframe's dark edges over the surface: more distinct grey levels when blended.
+  const auto levels = [](const Image& image) {
+    std::set<int> seen;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) seen.insert(static_cast<int>(image.at(x, y, 0) * 255));
+    return seen.size();
+  };
+  EXPECT_GT(levels(smooth.passes.at(pass::kWireframe)), levels(sharp.passes.at(pass::kWireframe)));
 }
 
 TEST_F(RasterTest, OccludedOverlayIsHiddenBehindTheSurface) {
