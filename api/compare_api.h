@@ -18,7 +18,7 @@ namespace limn::api {
 
 struct CompareRequest {
   render::pipeline::CompareJob job;
-  render::image::Format imageFormat = render::image::Format::Png;
+  render::image::Encoding encoding;  // "imageFormat", "imageQuality"
   // Per method, as the answer echoes it: its label and its params as given (a JSON object).
   std::vector<std::string> labels, paramsJson;
   std::vector<std::string> warnings;  // found while parsing, for the answer's "warnings"

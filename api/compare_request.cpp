@@ -168,10 +168,11 @@ CompareRequest parseDocument(const Value& root, const JobLimits& limits,
   }
   CompareRequest request;
   render::pipeline::CompareJob& job = request.job;
-  request::warnUnknownFields(root, "",
-                             {"mesh", "camera", "cameras", "methods", "metricSupersample",
-                              "outputs", "antialias", "imageFormat", "displacement"},
-                             request.warnings);
+  request::warnUnknownFields(
+      root, "",
+      {"mesh", "camera", "cameras", "methods", "metricSupersample", "outputs", "antialias",
+       "background", "imageFormat", "imageQuality", "displacement"},
+      request.warnings);
   parseCameras(root, limits, request);
   const Value* methods = json::find(root, "methods");
   if (!methods) json::fail("methods", "methods is required: the methods to compare");
@@ -202,10 +203,9 @@ CompareRequest parseDocument(const Value& root, const JobLimits& limits,
                    [](const CompareMethod& m) { return m.method == Method::Silhouette; })) {
     json::fail("outputs", "output \"contours\" is drawn by method \"silhouette\" only");
   }
-  if (const Value* v = json::find(root, "imageFormat")) {
-    request.imageFormat = json::choice<render::image::Format>(
-        *v, "imageFormat",
-        {{"png", render::image::Format::Png}, {"exr", render::image::Format::Exr}});
+  request.encoding = request::parseImageEncoding(root);
+  if (const Value* v = json::find(root, "background")) {
+    job.outputs.background = request::parseBackground(*v);
   }
 
   const Value* mesh = json::find(root, "mesh");

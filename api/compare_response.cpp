@@ -89,7 +89,7 @@ void writeRow(Writer& w, const CompareRow& row, const CompareRequest& request,
     writeRowTimings(w, row.timings);
     if (anyImages(request.job.outputs)) {
       w.Key("images");
-      response::writeImages(w, row.images, request.job.outputs, request.imageFormat, "method",
+      response::writeImages(w, row.images, request.job.outputs, request.encoding, "method",
                             warnings);
     }
   }
@@ -129,7 +129,7 @@ void writeReference(Writer& w, const CompareResult& result, const CompareRequest
     w.EndObject();
     if (anyImages(request.job.outputs)) {
       w.Key("images");
-      response::writeImages(w, ref.images, request.job.outputs, request.imageFormat, "reference",
+      response::writeImages(w, ref.images, request.job.outputs, request.encoding, "reference",
                             warnings);
     }
     w.Key("warnings");

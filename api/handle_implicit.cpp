@@ -94,7 +94,7 @@ Answer handleImplicit(std::string_view body, std::string_view accept,
     Answer answer;
     answer.body = writeRenderResponse(result, AnswerShape{.outputs = request.job.outputs,
                                                           .reference = request.job.reference,
-                                                          .imageFormat = request.imageFormat,
+                                                          .encoding = request.encoding,
                                                           .warnings = request.warnings});
     answer.stages = stageTimes(result.timings);
     return answer;

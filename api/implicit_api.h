@@ -17,7 +17,7 @@ namespace limn::api {
 
 struct ImplicitRequest {
   render::pipeline::ImplicitJob job;
-  render::image::Format imageFormat = render::image::Format::Png;
+  render::image::Encoding encoding;  // "imageFormat", "imageQuality"
   std::vector<std::string> warnings;
 };
 

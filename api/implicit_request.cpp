@@ -180,7 +180,7 @@ ImplicitRequest parseImplicitRequest(std::string_view body,
   render::pipeline::ImplicitJob& job = request.job;
   request::warnUnknownFields(root, "",
                              {"field", "polygonizer", "camera", "shading", "outputs", "antialias",
-                              "reference", "imageFormat", "params"},
+                              "background", "reference", "imageFormat", "imageQuality", "params"},
                              warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
@@ -204,8 +204,9 @@ ImplicitRequest parseImplicitRequest(std::string_view body,
     json::fail("outputs",
                "output \"diff\" compares with the reference: it needs \"reference\": true");
   }
-  if (const Value* v = json::find(root, "imageFormat")) {
-    request.imageFormat = request::parseImageFormat(*v);
+  request.encoding = request::parseImageEncoding(root);
+  if (const Value* v = json::find(root, "background")) {
+    job.outputs.background = request::parseBackground(*v);
   }
   if (const Value* v = json::find(root, "params")) {
     json::requireObject(*v, "params");

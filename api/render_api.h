@@ -20,7 +20,7 @@ namespace limn::api {
 
 struct RenderRequest {
   render::pipeline::RenderJob job;
-  render::image::Format imageFormat = render::image::Format::Png;
+  render::image::Encoding encoding;  // "imageFormat", "imageQuality"
   // Notes for the client found while parsing (ignored OBJ tags, unknown fields); the answer's
   // "warnings" lists them before the engine's own.
   std::vector<std::string> warnings;
@@ -36,7 +36,7 @@ RenderRequest parseRenderRequest(std::string_view json, const render::pipeline::
 struct AnswerShape {
   const render::pipeline::Outputs& outputs;
   bool reference;
-  render::image::Format imageFormat;
+  render::image::Encoding encoding;
   const std::vector<std::string>& warnings;
 };
 std::string writeRenderResponse(const render::pipeline::RenderResult& result,

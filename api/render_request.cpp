@@ -282,10 +282,11 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   RenderRequest request;
   std::vector<std::string>& warnings = request.warnings;
   render::pipeline::RenderJob& job = request.job;
-  warnUnknownFields(root, "",
-                    {"mesh", "camera", "method", "params", "shading", "outputs", "antialias",
-                     "reference", "imageFormat", "frames", "displacement"},
-                    warnings);
+  warnUnknownFields(
+      root, "",
+      {"mesh", "camera", "method", "params", "shading", "outputs", "antialias", "background",
+       "reference", "imageFormat", "imageQuality", "frames", "displacement"},
+      warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
   }
@@ -320,8 +321,9 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
                "output \"diff\" compares the method's colour with the reference: it needs "
                "\"reference\": true and a method other than \"limit\"");
   }
-  if (const Value* v = json::find(root, "imageFormat")) {
-    request.imageFormat = request::parseImageFormat(*v);
+  request.encoding = request::parseImageEncoding(root);
+  if (const Value* v = json::find(root, "background")) {
+    job.outputs.background = request::parseBackground(*v);
   }
 
   const Value* mesh = json::find(root, "mesh");
@@ -413,10 +415,43 @@ int parseAntialias(const Value& antialias) {
   return samples;
 }
 
-render::image::Format parseImageFormat(const Value& format) {
-  return json::choice<render::image::Format>(
-      format, "imageFormat",
-      {{"png", render::image::Format::Png}, {"exr", render::image::Format::Exr}});
+render::image::Encoding parseImageEncoding(const Value& request) {
+  render::image::Encoding encoding;
+  if (const Value* v = json::find(request, "imageFormat")) {
+    encoding.format = json::choice<render::image::Format>(*v, "imageFormat",
+                                                          {{"png", render::image::Format::Png},
+                                                           {"exr", render::image::Format::Exr},
+                                                           {"jpeg", render::image::Format::Jpeg},
+                                                           {"webp", render::image::Format::Webp}});
+  }
+  if (const Value* v = json::find(request, "imageQuality")) {
+    encoding.quality = json::integer(*v, "imageQuality");
+    if (encoding.quality < 1 || encoding.quality > 100) {
+      json::fail("imageQuality",
+                 "imageQuality must be in 1..100, got " + std::to_string(encoding.quality));
+    }
+  }
+  return encoding;
+}
+
+render::Background parseBackground(const Value& value) {
+  const std::string text(json::string(value, "background"));
+  render::Background background;
+  if (text == "transparent") return background;
+  background.transparent = false;
+  if (text == "white") return background;
+  const bool hex = text.size() == 7 && text[0] == '#' &&
+                   text.find_first_not_of("0123456789abcdefABCDEF", 1) == std::string::npos;
+  if (!hex) {
+    json::fail("background",
+               "background must be \"transparent\", \"white\" or an sRGB colour "
+               "\"#rrggbb\", got \"" +
+                   text.substr(0, 40) + "\"");
+  }
+  for (int c = 0; c < 3; ++c) {
+    background.rgb[c] = std::stoi(text.substr(1 + 2 * c, 2), nullptr, 16) / 255.0f;
+  }
+  return background;
 }
 
 Method parseMethod(const Value& value) { return api::parseMethod(value); }

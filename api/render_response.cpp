@@ -60,7 +60,8 @@ void writeImages(Writer& w, const render::ImageSet& images, const AnswerShape& s
                          " did not produce it");
       continue;
     }
-    render::image::EncodedImage encoded = render::image::encode(*image, name, shape.imageFormat);
+    render::image::EncodedImage encoded =
+        render::image::encode(*image, name, shape.encoding.format, shape.encoding.quality);
     w.Key(name);
     w.StartObject();
     w.Key("mime");
@@ -324,12 +325,12 @@ namespace response {
 void writeCamera(Writer& w, const render::Camera& camera) { api::writeCamera(w, camera); }
 
 void writeImages(Writer& w, const render::ImageSet& images, const Outputs& outputs,
-                 render::image::Format format, const char* owner,
+                 render::image::Encoding encoding, const char* owner,
                  std::vector<std::string>& warnings) {
   const std::vector<std::string> none;
   api::writeImages(
       w, images,
-      AnswerShape{.outputs = outputs, .reference = false, .imageFormat = format, .warnings = none},
+      AnswerShape{.outputs = outputs, .reference = false, .encoding = encoding, .warnings = none},
       owner, warnings);
 }
 
@@ -355,7 +356,7 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
                                 const RenderRequest& request) {
   return writeRenderResponse(result, AnswerShape{.outputs = request.job.outputs,
                                                  .reference = request.job.reference,
-                                                 .imageFormat = request.imageFormat,
+                                                 .encoding = request.encoding,
                                                  .warnings = request.warnings});
 }
 
@@ -432,7 +433,11 @@ void appendImages(const json::Value* images, const std::string& prefix,
     const json::Value* data = json::find(member.value, "data");
     if (!mime || !data || !mime->IsString() || !data->IsString()) continue;
     const std::string_view type = mime->GetString();
-    const char* extension = type == "image/png" ? ".png" : type == "image/x-exr" ? ".exr" : ".bin";
+    const char* extension = type == "image/png"     ? ".png"
+                            : type == "image/x-exr" ? ".exr"
+                            : type == "image/jpeg"  ? ".jpg"
+                            : type == "image/webp"  ? ".webp"
+                                                    : ".bin";
     if (auto bytes = decodeBase64(data->GetString())) {
       out.push_back({prefix + member.name.GetString() + extension, std::move(*bytes)});
     }

@@ -85,8 +85,12 @@ render::pipeline::Outputs parseOutputs(const rapidjson::Value& outputs);
 // "shading": "flat" | "smooth" | "normal-map".
 render::Shading parseShading(const rapidjson::Value& shading);
 
-// "imageFormat": "png" | "exr".
-render::image::Format parseImageFormat(const rapidjson::Value& format);
+// "imageFormat": "png" | "exr" | "jpeg" | "webp", and "imageQuality" (1..100, JPEG and WebP) of
+// a request object; what it lacks keeps its default.
+render::image::Encoding parseImageEncoding(const rapidjson::Value& request);
+
+// "background": "transparent" | "white" | "#rrggbb" (an sRGB colour).
+render::Background parseBackground(const rapidjson::Value& background);
 
 // "antialias": samples per pixel of the colour outputs, 1, 4, 8 or 16 (400 naming it otherwise).
 int parseAntialias(const rapidjson::Value& antialias);

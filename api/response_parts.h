@@ -25,7 +25,7 @@ void writeCamera(json::Writer& w, const render::Camera& camera);
 // {"color": {"mime", "width", "height", "data"}, ...}: the passes `outputs` asks for, encoded
 // and in base64; a requested pass `owner` ("method", "reference") lacks is a warning instead.
 void writeImages(json::Writer& w, const render::ImageSet& images,
-                 const render::pipeline::Outputs& outputs, render::image::Format format,
+                 const render::pipeline::Outputs& outputs, render::image::Encoding encoding,
                  const char* owner, std::vector<std::string>& warnings);
 
 // {"silhouette": {...}, "image": {...}, "depth", "normal", "geometry"}: the metrics present.

@@ -3,6 +3,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -48,9 +49,30 @@ void writeToMemory(const char* fileName, const OIIO::ImageSpec& spec, const void
   }
 }
 
+// 8-bit pixels for the lossy formats: JPEG without alpha (RGBA laid over white), WebP with RGB
+// or RGBA (grey repeated); `channels` says how many were kept.
+std::vector<uint8_t> lossyPixels(const Image& image, const std::string& passName, Format format,
+                                 int& channels) {
+  const std::vector<uint8_t> bytes = to8Bit(image, passName);
+  const int in = image.channels;
+  channels = format == Format::Jpeg ? std::min(in, 3) : (in == 4 ? 4 : 3);
+  if (format == Format::Jpeg && in == 1) channels = 1;
+  std::vector<uint8_t> out(static_cast<size_t>(image.width) * image.height * channels);
+  for (size_t p = 0; p < static_cast<size_t>(image.width) * image.height; ++p) {
+    const uint8_t* from = &bytes[p * in];
+    uint8_t* to = &out[p * channels];
+    const float alpha = in == 4 && channels == 3 ? from[3] / 255.0f : 1.0f;
+    for (int c = 0; c < channels; ++c) {
+      const uint8_t value = from[in == 1 ? 0 : std::min(c, in - 1)];
+      to[c] = c < 3 ? static_cast<uint8_t>(value * alpha + 255.0f * (1.0f - alpha) + 0.5f) : value;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
-EncodedImage encode(const Image& image, const std::string& passName, Format format) {
+EncodedImage encode(const Image& image, const std::string& passName, Format format, int quality) {
   checkEncodable(image);
   EncodedImage result;
   result.width = image.width;
@@ -72,6 +94,16 @@ EncodedImage encode(const Image& image, const std::string& passName, Format form
     spec.attribute("png:filter", kPngFilterSub);
     writeToMemory("limn.png", spec, pixels.data(), result.bytes);
     result.mime = "image/png";
+  } else if (format == Format::Jpeg || format == Format::Webp) {
+    int channels = 0;
+    std::vector<uint8_t> pixels = lossyPixels(image, passName, format, channels);
+    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    spec.attribute("Compression", (format == Format::Jpeg ? "jpeg:" : "webp:") +
+                                      std::to_string(std::clamp(quality, 1, 100)));
+    const bool jpeg = format == Format::Jpeg;
+    writeToMemory(jpeg ? "limn.jpg" : "limn.webp", spec, pixels.data(), result.bytes);
+    result.mime = jpeg ? "image/jpeg" : "image/webp";
   } else {
     OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
     spec.channelnames = exrChannelNames(image.channels, passName);
@@ -86,10 +118,18 @@ Image decode(const std::vector<unsigned char>& bytes) {
   // The reader is chosen by the file's magic number, not by a name.
   static const unsigned char kPngMagic[4] = {0x89, 'P', 'N', 'G'};
   static const unsigned char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+  static const unsigned char kJpegMagic[3] = {0xff, 0xd8, 0xff};
   const char* fileName = nullptr;
   if (bytes.size() >= 4 && std::memcmp(bytes.data(), kPngMagic, 4) == 0) fileName = "limn.png";
   if (bytes.size() >= 4 && std::memcmp(bytes.data(), kExrMagic, 4) == 0) fileName = "limn.exr";
-  if (!fileName) throw std::invalid_argument("image::decode: neither PNG nor OpenEXR data");
+  if (bytes.size() >= 3 && std::memcmp(bytes.data(), kJpegMagic, 3) == 0) fileName = "limn.jpg";
+  if (bytes.size() >= 12 && std::memcmp(bytes.data(), "RIFF", 4) == 0 &&
+      std::memcmp(bytes.data() + 8, "WEBP", 4) == 0) {
+    fileName = "limn.webp";
+  }
+  if (!fileName) {
+    throw std::invalid_argument("image::decode: neither PNG, OpenEXR, JPEG nor WebP data");
+  }
 
   OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
   OIIO::ImageSpec config;

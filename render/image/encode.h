@@ -1,5 +1,5 @@
-// Encoding of ImageSet passes into files held in memory (PNG 8-bit or OpenEXR float), through
-// OpenImageIO, and decoding for tests and tools.
+// Encoding of ImageSet passes into files held in memory (PNG 8-bit, JPEG, WebP or OpenEXR
+// float), through OpenImageIO, and decoding for tests and tools.
 #pragma once
 
 #include <string>
@@ -9,10 +9,19 @@
 
 namespace limn::render::image {
 
-enum class Format { Png, Exr };
+enum class Format { Png, Exr, Jpeg, Webp };
+
+// Quality of the lossy formats (JPEG, WebP), 1..100.
+inline constexpr int kDefaultQuality = 90;
+
+// How a request's images are encoded.
+struct Encoding {
+  Format format = Format::Png;
+  int quality = kDefaultQuality;  // JPEG and WebP only
+};
 
 struct EncodedImage {
-  std::string mime;  // "image/png" or "image/x-exr"
+  std::string mime;  // "image/png", "image/x-exr", "image/jpeg" or "image/webp"
   int width = 0, height = 0;
   std::vector<unsigned char> bytes;
 };
@@ -20,9 +29,12 @@ struct EncodedImage {
 // How a pass maps to 8 bits for PNG: color/wireframe as RGBA, mask as grey 0/255, depth as
 // grey with the nearest covered depth white and the farthest dark (empty pixels black),
 // normal as RGB = (n + 1) / 2 (empty pixels black). EXR keeps the float values as they are.
-EncodedImage encode(const Image& image, const std::string& passName, Format format);
+// JPEG and WebP take the same 8-bit values at `quality`; JPEG has no alpha, so an RGBA image is
+// laid over white first; WebP keeps RGBA and writes grey images as RGB.
+EncodedImage encode(const Image& image, const std::string& passName, Format format,
+                    int quality = kDefaultQuality);
 
-// Decodes PNG or EXR bytes into float pixels (PNG values scaled to [0, 1]).
+// Decodes PNG, EXR, JPEG or WebP bytes into float pixels (8-bit values scaled to [0, 1]).
 Image decode(const std::vector<unsigned char>& bytes);
 
 }  // namespace limn::render::image

@@ -79,6 +79,11 @@ ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference
   if (!isReference) keep(outputs.cage, pass::kCage);
   if (!isReference) keep(outputs.diff, pass::kDiff);
   if (!isReference) keep(outputs.patches, pass::kPatches);
+  for (const char* colorLike :
+       {pass::kColor, pass::kWireframe, pass::kContours, pass::kCage, pass::kPatches}) {
+    auto it = selected.passes.find(colorLike);
+    if (it != selected.passes.end()) applyBackground(it->second, outputs.background);
+  }
   return selected;
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "render/core/background.h"
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
 #include "render/core/image.h"
@@ -78,6 +79,8 @@ struct Outputs {
   // normals, and so every metric but the colour difference, are one sample per pixel either way.
   int antialias = kDefaultAntialias;
   static constexpr int kDefaultAntialias = 4;
+  // Where the colour-like outputs are not covered (background.h): transparent by default.
+  Background background;
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.

@@ -1,7 +1,8 @@
-// Anti-aliased pictures through the real server: "antialias" (samples per pixel of the colour
-// outputs, 4 by default) blends every outline of the method's picture and of the reference's,
-// one sample per pixel blends none, the metrics that do not read colour are the same either
-// way, and a value outside 1, 4, 8, 16 is refused naming the field, on every endpoint.
+// Pictures through the real server: "antialias" (samples per pixel of the colour outputs, 4 by
+// default) blends every outline of the method's picture and of the reference's, one sample per
+// pixel blends none, the metrics that do not read colour are the same either way, and a value
+// outside 1, 4, 8, 16 is refused naming the field, on every endpoint; "background" transparent
+// (straight alpha) or opaque; "imageFormat" jpeg and webp at "imageQuality".
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
 
@@ -69,12 +70,11 @@ class PicturesServer : public ::testing::Test {
 };
 ServerProcess* PicturesServer::server_ = nullptr;
 
-std::string renderBody(const std::string& obj, const std::string& scheme,
-                       const std::string& method, const std::string& antialias) {
+std::string renderBody(const std::string& obj, const std::string& scheme, const std::string& method,
+                       const std::string& antialias) {
   return R"({"mesh":{"format":"obj","scheme":")" + scheme + R"(","data":")" + obj +
          R"("},"camera":{"width":160,"height":160,"eye":[2.2,1.6,3.4]},"method":")" + method +
-         R"(","params":{"level":2},"outputs":["color","mask"],"reference":true)" + antialias +
-         "}";
+         R"(","params":{"level":2},"outputs":["color","mask"],"reference":true)" + antialias + "}";
 }
 
 render::Image imageOf(const rapidjson::Value& images, const char* pass) {
@@ -131,9 +131,8 @@ TEST_F(PicturesServer, MetricsThatDoNotReadColourAreTheSameWithAndWithoutAntiali
   struct Case {
     std::string obj, scheme;
   };
-  const Case cases[] = {{torusObj(), "catmull-clark"},
-                        {kCreasedCube, "catmull-clark"},
-                        {kTetrahedron, "loop"}};
+  const Case cases[] = {
+      {torusObj(), "catmull-clark"}, {kCreasedCube, "catmull-clark"}, {kTetrahedron, "loop"}};
   for (const Case& c : cases) {
     for (const char* method : {"coarse", "uniform", "adaptive", "silhouette", "patches"}) {
       auto smooth = answer("/v1/render", renderBody(c.obj, c.scheme, method, ""));
@@ -192,11 +191,89 @@ TEST_F(PicturesServer, AntialiasOutsideItsChoicesIsRefusedNamingIt) {
   EXPECT_STREQ((*implicit)["error"]["detail"]["field"].GetString(), "antialias");
   // 8 and 16 are drawn with as many samples as the device's OpenGL takes, and say so.
   auto sixteen = answer("/v1/render", cube + R"(,"antialias":16,"outputs":["color"]})");
-  const bool fewer = std::string((*sixteen)["warnings"].Size() ? (*sixteen)["warnings"][0].GetString()
-                                                                 : "")
-                         .find("samples per pixel, the most") != std::string::npos;
+  const bool fewer =
+      std::string((*sixteen)["warnings"].Size() ? (*sixteen)["warnings"][0].GetString() : "")
+          .find("samples per pixel, the most") != std::string::npos;
   EXPECT_GT(partlyCovered(imageOf((*sixteen)["images"], "color")), 10);
   std::printf("antialias 16 drawn with fewer samples on this device: %s\n", fewer ? "yes" : "no");
+}
+
+std::string torusRequest(const std::string& extra) {
+  return R"({"mesh":{"format":"obj","data":")" + torusObj() +
+         R"("},"camera":{"width":128,"height":128,"eye":[2.2,1.6,3.4]},"method":"adaptive",)"
+         R"("outputs":["color","mask"])" +
+         extra + "}";
+}
+
+// "transparent" (the default) has straight alpha: an edge pixel holds the surface's colour with
+// alpha its coverage, so laying it over white gives exactly what "white" answers; an opaque
+// colour fills every uncovered pixel with itself at alpha 1.
+TEST_F(PicturesServer, BackgroundsAreTransparentWithStraightAlphaOrOpaque) {
+  auto transparent = answer("/v1/render", torusRequest(""));
+  auto white = answer("/v1/render", torusRequest(R"(,"background":"white")"));
+  auto red = answer("/v1/render", torusRequest(R"(,"background":"#ff0000")"));
+  const render::Image clear = imageOf((*transparent)["images"], "color");
+  const render::Image onWhite = imageOf((*white)["images"], "color");
+  const render::Image onRed = imageOf((*red)["images"], "color");
+  const render::Image mask = imageOf((*transparent)["images"], "mask");
+  int uncovered = 0, edges = 0;
+  for (int y = 0; y < clear.height; ++y) {
+    for (int x = 0; x < clear.width; ++x) {
+      const float a = clear.at(x, y, 3);
+      EXPECT_EQ(onWhite.at(x, y, 3), 1.0f);
+      EXPECT_EQ(onRed.at(x, y, 3), 1.0f);
+      if (a == 0.0f) {
+        ++uncovered;
+        EXPECT_EQ(mask.at(x, y), 0.0f) << x << "," << y;
+        EXPECT_EQ(onRed.at(x, y, 0), 1.0f);
+        EXPECT_EQ(onRed.at(x, y, 1), 0.0f);
+        continue;
+      }
+      edges += a < 1.0f;
+      for (int c = 0; c < 3; ++c) {
+        const float over = a * clear.at(x, y, c) + (1 - a) * 1.0f;
+        ASSERT_NEAR(onWhite.at(x, y, c), over, 3.0f / 255) << x << "," << y << " alpha " << a;
+      }
+    }
+  }
+  EXPECT_GT(uncovered, 1000);
+  EXPECT_GT(edges, 50);
+}
+
+TEST_F(PicturesServer, JpegAndWebpComeBackDecodableAtTheirQuality) {
+  struct Format {
+    const char *name, *mime;
+    int channels;
+  };
+  for (const Format& f : {Format{"jpeg", "image/jpeg", 3}, Format{"webp", "image/webp", 4}}) {
+    const std::string format = std::string(R"(,"imageFormat":")") + f.name + "\"";
+    auto good = answer("/v1/render", torusRequest(format + R"(,"imageQuality":95)"));
+    auto poor = answer("/v1/render", torusRequest(format + R"(,"imageQuality":10)"));
+    const rapidjson::Value& color = (*good)["images"]["color"];
+    EXPECT_STREQ(color["mime"].GetString(), f.mime);
+    const render::Image image = imageOf((*good)["images"], "color");
+    EXPECT_EQ(image.width, 128);
+    EXPECT_EQ(image.channels, f.channels) << f.name;
+    EXPECT_LT(std::string((*poor)["images"]["color"]["data"].GetString()).size(),
+              std::string(color["data"].GetString()).size())
+        << f.name << ": quality 10 is smaller than 95";
+    // Close to the PNG of the same picture (laid over white where JPEG has no alpha).
+    auto png = answer("/v1/render", torusRequest(R"(,"background":"white")"));
+    const render::Image reference = imageOf((*png)["images"], "color");
+    double error = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const float a = f.channels == 4 ? image.at(x, y, 3) : 1.0f;
+          error += std::fabs(a * image.at(x, y, c) + (1 - a) - reference.at(x, y, c));
+        }
+    EXPECT_LT(error / (3.0 * image.width * image.height), 0.02) << f.name;
+  }
+  for (const char* bad : {R"(,"imageQuality":0)", R"(,"imageFormat":"gif")",
+                          R"(,"background":"#12345")", R"(,"background":"blue")"}) {
+    auto refused = answer("/v1/render", torusRequest(bad), 400);
+    ASSERT_TRUE(refused->HasMember("error")) << bad;
+  }
 }
 
 }  // namespace

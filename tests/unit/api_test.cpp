@@ -617,7 +617,7 @@ TEST(RenderRequest, MinimalRequestTakesTheDefaults) {
                r.job.outputs.wireframe);
   EXPECT_FALSE(r.job.reference);
   EXPECT_EQ(r.job.shading, render::Shading::Smooth);
-  EXPECT_EQ(r.imageFormat, render::image::Format::Png);
+  EXPECT_EQ(r.encoding.format, render::image::Format::Png);
   EXPECT_FALSE(r.job.camera.eye || r.job.camera.width || r.job.camera.fovYDeg);
   EXPECT_EQ(r.job.params.level, 3);
   EXPECT_EQ(r.job.params.metricSupersample, 4);
@@ -651,7 +651,7 @@ TEST(RenderRequest, ReadsEveryField) {
   EXPECT_TRUE(r.job.outputs.mask && r.job.outputs.depth && r.job.outputs.normal &&
               r.job.outputs.wireframe);
   EXPECT_TRUE(r.job.reference);
-  EXPECT_EQ(r.imageFormat, render::image::Format::Exr);
+  EXPECT_EQ(r.encoding.format, render::image::Format::Exr);
   // Unknown fields are accepted (forward compatible) and mentioned.
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_TRUE(contains(r.warnings[0], "futureField")) << r.warnings[0];
@@ -702,7 +702,10 @@ TEST(RenderRequest, WrongTypesNameTheField) {
       {R"(, "outputs": "color")", "outputs"},
       {R"(, "outputs": ["color", 1])", "outputs[1]"},
       {R"(, "reference": "yes")", "reference"},
-      {R"(, "imageFormat": "jpeg")", "imageFormat"},
+      {R"(, "imageFormat": "gif")", "imageFormat"},
+      {R"(, "imageQuality": 101)", "imageQuality"},
+      {R"(, "background": "#12")", "background"},
+      {R"(, "antialias": 2)", "antialias"},
   };
   for (const Case& c : cases) {
     ApiError e = parseError(cubeRequest(c.rest));
@@ -978,7 +981,7 @@ TEST(RenderResponse, OmitsReferenceWhenNotAskedAndWarnsOnMissingImages) {
   api::RenderRequest request;
   request.job.outputs = {
       .color = false, .mask = false, .depth = false, .normal = true, .wireframe = false};
-  request.imageFormat = render::image::Format::Exr;
+  request.encoding.format = render::image::Format::Exr;
   render::pipeline::RenderResult result = handMadeResult();
   result.metrics = {};
   std::string body = api::writeRenderResponse(result, request);
