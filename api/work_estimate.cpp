@@ -100,6 +100,7 @@ WorkSize estimateWork(std::string_view path, std::string_view body,
   const Value* mesh = member(root, "mesh");
   work.controlFaces = meshFaces(mesh, facesOfMesh);
   const bool loop = isLoop(mesh);
+  work.samplesCost = numberOr(member(root, "antialias"), 4) > 1 ? 2.5 : 1.0;
 
   if (path == "/v1/compare") {
     double pixels = 0;
@@ -154,8 +155,9 @@ double referenceSeconds(const WorkSize& work) {
   constexpr double kFixed = 2e-3, kPixel = 4e-8, kReferenceSample = 8e-8, kTriangle = 8e-7,
                    kCell = 4e-9;
   if (work.unread) return 10.0;
-  return kFixed + kPixel * work.pixels + kReferenceSample * work.referencePixels +
-         kTriangle * work.triangles + kCell * work.implicitCells;
+  return kFixed + kPixel * work.samplesCost * work.pixels +
+         kReferenceSample * work.referencePixels + kTriangle * work.triangles +
+         kCell * work.implicitCells;
 }
 
 }  // namespace limn::api

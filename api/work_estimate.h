@@ -20,7 +20,10 @@ struct WorkSize {
   double triangles = 0;        // the approximations' triangles, over every row and frame
   double controlFaces = 0;
   double implicitCells = 0;  // resolution^3 of /v1/implicit
-  bool unread = false;       // the body was too large to read: count it as heavy
+  // The raster cost of an output pixel relative to one sample: multisampling ("antialias" above
+  // 1, 4 by default) costs llvmpipe 2-3x (bench/antialias_results.md).
+  double samplesCost = 1;
+  bool unread = false;  // the body was too large to read: count it as heavy
 };
 
 inline constexpr size_t kMaxReadBytes = 256 * 1024;

@@ -79,7 +79,7 @@ struct ReferenceOptions {
   // The rasteriser's sample positions for an anti-aliased picture (Rasterizer::samplePositions):
   // with more than one, the colour of pixels along edges is the mean of rays through them, as
   // the rasteriser resolves its samples (antialiasEdges in reference_passes.h).
-  std::vector<std::array<float, 2>> colorSamples;
+  std::vector<std::array<float, 2>> colorSamples{};
 };
 
 // `passes.supersample` > 0 also fills the supersampled mask. Uses all hardware threads through

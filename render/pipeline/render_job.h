@@ -80,7 +80,7 @@ struct Outputs {
   int antialias = kDefaultAntialias;
   static constexpr int kDefaultAntialias = 4;
   // Where the colour-like outputs are not covered (background.h): transparent by default.
-  Background background;
+  Background background{};
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.

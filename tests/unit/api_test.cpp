@@ -1303,6 +1303,13 @@ TEST(WorkEstimate, ReadsSizesFromTheRequestAndRanksSmallBelowHeavy) {
   EXPECT_EQ(preview.pixels, 256.0 * 256.0);
   EXPECT_EQ(preview.referencePixels, 0);
   EXPECT_EQ(preview.triangles, 4);
+  EXPECT_EQ(preview.samplesCost, 2.5);  // anti-aliased by default
+  EXPECT_EQ(api::estimateWork("/v1/render",
+                              R"({"mesh":)" + cube + R"(,"camera":{"width":256,"height":256},)" +
+                                  R"("antialias":1})",
+                              none)
+                .samplesCost,
+            1.0);
   api::WorkSize compared = api::estimateWork(
       "/v1/render",
       R"({"mesh":)" + cube +
