@@ -26,8 +26,8 @@ namespace {
 // pixel (2048^2: 176 MiB), the coverage pass 1 byte per pixel (4096^2: 16 MiB).
 constexpr int kFrameTileCap = 2048;
 constexpr int kCoverageTileCap = 4096;
-// Samples of one tile of the anti-aliased colour pass (16 bytes each: colour, overlay, depth):
-// 8M, 128 MiB, i.e. 1448^2 at 4 samples per pixel, 1024^2 at 8, 724^2 at 16.
+// Samples of one tile of the anti-aliased colour pass (12 bytes each: colour, overlay, depth):
+// 8M, 96 MiB, i.e. 1448^2 at 4 samples per pixel, 1024^2 at 8, 724^2 at 16.
 constexpr double kMultisampleTileSamples = 8 << 20;
 
 // Attachments of the frame pass; fragment output i writes attachment i.
