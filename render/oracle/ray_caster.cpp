@@ -35,6 +35,25 @@ void forEachBand(int height, const CancelToken& cancel, const Body& body) {
   if (cancelled) throw Cancelled();
 }
 
+// Runs body(begin, end, context) over chunks of [0, count) on all threads, with FTZ/DAZ set, an
+// intersect context per chunk and the cancel token checked before each.
+template <typename Body>
+void forEachChunk(size_t count, size_t grain, const CancelToken& cancel, const Body& body) {
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
+                        cancelled = true;
+                        return;
+                      }
+                      FlushDenormalsScope ftz;
+                      RTCIntersectContext context;
+                      rtcInitIntersectContext(&context);
+                      body(r.begin(), r.end(), context);
+                    });
+  if (cancelled) throw Cancelled();
+}
+
 // Fills lane `k` of a ray packet (or a single ray through the same fields) with a pixel's ray.
 // Embree gets the ray from its near point on, so tnear is 0 and t is measured from there.
 template <typename RayN>
@@ -213,17 +232,9 @@ uint32_t occludedLanes(RTCScene scene, const Camera& camera, const Vec2* points,
 void castClosestHitsAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
                        std::vector<PixelHit>& hits, const CancelToken& cancel) {
   hits.assign(points.size(), PixelHit{});
-  std::atomic<bool> cancelled{false};
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, points.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-        if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
-          cancelled = true;
-          return;
-        }
-        FlushDenormalsScope ftz;
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        for (size_t i = r.begin(); i < r.end(); ++i) {
+  forEachChunk(
+      points.size(), 256, cancel, [&](size_t begin, size_t end, RTCIntersectContext& context) {
+        for (size_t i = begin; i < end; ++i) {
           const PixelRay ray = pixelRay(camera, points[i].x, points[i].y);
           RTCRayHit rayhit;
           setRay(rayhit.ray, ray);
@@ -234,31 +245,20 @@ void castClosestHitsAt(RTCScene scene, const Camera& camera, const std::vector<V
           hits[i] = {rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, ray.tNear + rayhit.ray.tfar};
         }
       });
-  if (cancelled) throw Cancelled();
 }
 
 void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2>& points,
                     std::vector<char>& covered, const CancelToken& cancel) {
   covered.assign(points.size(), 0);
   const size_t packets = (points.size() + 15) / 16;
-  std::atomic<bool> cancelled{false};
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, packets, 64), [&](const tbb::blocked_range<size_t>& r) {
-        if (cancelled.load(std::memory_order_relaxed) || cancel.expired()) {
-          cancelled = true;
-          return;
-        }
-        FlushDenormalsScope ftz;
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        for (size_t p = r.begin(); p < r.end(); ++p) {
-          const size_t first = 16 * p;
-          const int count = static_cast<int>(std::min<size_t>(16, points.size() - first));
-          uint32_t hits = occludedLanes(scene, camera, points.data() + first, count, context);
-          for (int k = 0; k < count; ++k) covered[first + k] = (hits >> k) & 1;
-        }
-      });
-  if (cancelled) throw Cancelled();
+  forEachChunk(packets, 64, cancel, [&](size_t begin, size_t end, RTCIntersectContext& context) {
+    for (size_t p = begin; p < end; ++p) {
+      const size_t first = 16 * p;
+      const int count = static_cast<int>(std::min<size_t>(16, points.size() - first));
+      uint32_t hits = occludedLanes(scene, camera, points.data() + first, count, context);
+      for (int k = 0; k < count; ++k) covered[first + k] = (hits >> k) & 1;
+    }
+  });
 }
 
 Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
