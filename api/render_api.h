@@ -50,9 +50,12 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
 
 // parse -> run -> write, with every failure turned into its JSON error answer (InputError ->
 // 4xx, Cancelled -> 504 timeout, anything else -> 500 internal). Never throws.
+// With an Accept header that ranks an image type (image/png, image/jpeg, image/webp,
+// image/x-exr; image/* is PNG) above JSON, a request for one image without reference images is
+// answered by the picture itself, with X-Limn-* headers for its counts (406 for more images).
 Answer handleRender(std::string_view body, const render::pipeline::JobLimits& limits,
                     render::pipeline::RenderContext& context, const render::CancelToken& cancel,
-                    render::mesh::MeshCache* meshes = nullptr);
+                    render::mesh::MeshCache* meshes = nullptr, std::string_view accept = {});
 
 // POST /v1/tessellate: the body of a /v1/render request; answers the approximation's mesh
 // (positions, limit normals, triangles) as GLB, PLY or OBJ by `accept` (api/mesh_export.h),

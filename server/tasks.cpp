@@ -14,7 +14,7 @@ api::Answer runTask(const Task& task, const render::pipeline::JobLimits& limits,
                     render::mesh::MeshCache* meshes) {
   switch (task.endpoint) {
     case Endpoint::Render:
-      return api::handleRender(task.body, limits, context, cancel, meshes);
+      return api::handleRender(task.body, limits, context, cancel, meshes, task.accept);
     case Endpoint::Silhouette:
       return api::handleSilhouette(task.body, task.accept, limits, cancel, meshes);
     case Endpoint::Tessellate:

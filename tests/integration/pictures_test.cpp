@@ -2,7 +2,8 @@
 // default) blends every outline of the method's picture and of the reference's, one sample per
 // pixel blends none, the metrics that do not read colour are the same either way, and a value
 // outside 1, 4, 8, 16 is refused naming the field, on every endpoint; "background" transparent
-// (straight alpha) or opaque; "imageFormat" jpeg and webp at "imageQuality".
+// (straight alpha) or opaque; "imageFormat" jpeg and webp at "imageQuality"; an Accept header
+// that prefers an image type gets the picture itself.
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
 
@@ -274,6 +275,32 @@ TEST_F(PicturesServer, JpegAndWebpComeBackDecodableAtTheirQuality) {
     auto refused = answer("/v1/render", torusRequest(bad), 400);
     ASSERT_TRUE(refused->HasMember("error")) << bad;
   }
+}
+
+// Accept ranking an image type above JSON: the picture itself, the same pixels as the JSON
+// answer's; 406 when the request asks for more than one picture; JSON where JSON ranks higher.
+TEST_F(PicturesServer, AcceptAnImageTypeAndTheAnswerIsThePicture) {
+  const std::string body = R"({"mesh":{"format":"obj","data":")" + torusObj() +
+                           R"("},"camera":{"width":96,"height":96},"method":"adaptive"})";
+  auto json = answer("/v1/render", body);
+  const render::Image fromJson = imageOf((*json)["images"], "color");
+  HttpResponse png = post(port(), "/v1/render", body, {{"Accept", "image/png"}});
+  ASSERT_EQ(png.status, 200);
+  EXPECT_EQ(png.header("Content-Type"), "image/png");
+  EXPECT_EQ(png.header("X-Limn-Pass"), "color");
+  const render::Image picture = render::image::decode({png.body.begin(), png.body.end()});
+  EXPECT_EQ(picture.pixels, fromJson.pixels);
+  HttpResponse webp =
+      post(port(), "/v1/render", body, {{"Accept", "application/json;q=0.5, image/webp"}});
+  EXPECT_EQ(webp.header("Content-Type"), "image/webp");
+  EXPECT_EQ(render::image::decode({webp.body.begin(), webp.body.end()}).width, 96);
+  HttpResponse preferJson =
+      post(port(), "/v1/render", body, {{"Accept", "application/json, image/png;q=0.2"}});
+  EXPECT_EQ(preferJson.header("Content-Type"), "application/json");
+  const std::string two = body.substr(0, body.size() - 1) + R"(,"outputs":["color","mask"]})";
+  HttpResponse refused = post(port(), "/v1/render", two, {{"Accept", "image/png"}});
+  EXPECT_EQ(refused.status, 406);
+  EXPECT_EQ(refused.header("Content-Type"), "application/json");
 }
 
 }  // namespace
