@@ -4,6 +4,7 @@
 #include <rapidjson/error/en.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -19,10 +20,11 @@ using Value = rapidjson::Value;
 class ConfigReader {
  public:
   ConfigReader(const Value& object, std::string source, std::string prefix)
-      : object_(object), source_(std::move(source)), prefix_(std::move(prefix)) {
+      : source_(std::move(source)), prefix_(std::move(prefix)) {
     if (!object.IsObject()) fail(prefix_.empty() ? "the top level" : prefix_, "must be an object");
     for (auto it = object.MemberBegin(); it != object.MemberEnd(); ++it) {
-      pending_.push_back(it->name.GetString());
+      pending_.push_back(
+          {std::string(it->name.GetString(), it->name.GetStringLength()), &it->value});
     }
   }
 
@@ -81,29 +83,53 @@ class ConfigReader {
 
   // Every key must have been taken by now.
   void finish() const {
-    if (!pending_.empty()) fail(path(pending_.front().c_str()), "is not a known key");
+    if (!pending_.empty()) fail(path(pending_.front().name), "is not a known key");
   }
 
-  std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  std::string path(const std::string& key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
 
  private:
+  // The member's own value, not object_[key]: a name with an embedded NUL must stay unknown
+  // rather than be looked up by its prefix (rapidjson asserts on a missing member).
   const Value* take(const char* key) {
     for (auto it = pending_.begin(); it != pending_.end(); ++it) {
-      if (*it == key) {
+      if (it->name == key) {
+        const Value* value = it->value;
         pending_.erase(it);
-        return &object_[key];
+        return value;
       }
     }
     return nullptr;
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& message) const {
-    throw ConfigError(source_ + ": \"" + key + "\" " + message);
+    throw ConfigError(source_ + ": \"" + printable(key) + "\" " + message);
   }
 
-  const Value& object_;
+  // A key as JSON would write it: control characters (a NUL would end what()) as \u00XX.
+  static std::string printable(const std::string& key) {
+    std::string out;
+    for (unsigned char c : key) {
+      if (c >= 0x20) {
+        out += static_cast<char>(c);
+        continue;
+      }
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    }
+    return out;
+  }
+
+  struct Member {
+    std::string name;
+    const Value* value;
+  };
+
   std::string source_, prefix_;
-  std::vector<std::string> pending_;
+  std::vector<Member> pending_;
 };
 
 void readLimits(const Value& object, const std::string& source, ServiceConfig& config) {

@@ -1123,6 +1123,19 @@ TEST(Config, AuthTokenAndCorsOrigins) {
   EXPECT_THROW(api::parseConfig(R"({"logLevel": "loud"})"), api::ConfigError);
 }
 
+// Found by the config fuzzer: a key with an embedded NUL ("port\u0000x") once matched "port" by
+// its C-string prefix and was then looked up whole, which rapidjson asserts on.
+TEST(Config, KeysWithEmbeddedNulOrRepeatedAreRefusedNotLookedUpByPrefix) {
+  try {
+    api::parseConfig(R"({"port\u0000x": 8081})");
+    FAIL() << "a key with an embedded NUL was accepted";
+  } catch (const api::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a known key"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(api::parseConfig(R"({"limits": {"maxFaces\u0000": 10}})"), api::ConfigError);
+  EXPECT_THROW(api::parseConfig(R"({"port": 1, "port": 2})"), api::ConfigError);
+}
+
 TEST(Config, ReadsValuesAndKeepsDefaultsForMissingKeys) {
   api::ServiceConfig c = api::parseConfig(
       R"({"port": 0, "workers": 3, "limits": {"maxImageSide": 1024, "minDicingRate": 0.5}})");
