@@ -55,4 +55,43 @@ bool sameMediaType(std::string_view a, std::string_view b) {
          });
 }
 
+std::optional<MeshFormat> chooseMeshFormat(std::string_view accept) {
+  if (parseAccept(accept).empty()) return MeshFormat::Glb;
+  struct Candidate {
+    const char* type;
+    MeshFormat format;
+  };
+  static constexpr Candidate kTypes[] = {{"model/gltf-binary", MeshFormat::Glb},
+                                         {"application/x-ply", MeshFormat::Ply},
+                                         {"model/ply", MeshFormat::Ply},
+                                         {"text/plain", MeshFormat::Obj},
+                                         {"model/obj", MeshFormat::Obj}};
+  std::optional<MeshFormat> best;
+  double bestQ = 0, anyQ = 0;
+  for (const MediaRange& range : parseAccept(accept)) {
+    if (range.type == "*/*" || sameMediaType(range.type, "model/*")) anyQ = std::max(anyQ, range.q);
+    for (const Candidate& c : kTypes) {
+      if (sameMediaType(range.type, c.type) && range.q > bestQ) {
+        best = c.format;
+        bestQ = range.q;
+      }
+    }
+  }
+  if (best && bestQ >= anyQ) return best;
+  if (anyQ > 0) return MeshFormat::Glb;
+  return std::nullopt;
+}
+
+const char* meshMime(MeshFormat format) {
+  switch (format) {
+    case MeshFormat::Glb:
+      return "model/gltf-binary";
+    case MeshFormat::Ply:
+      return "application/x-ply";
+    case MeshFormat::Obj:
+      return "text/plain; charset=utf-8";
+  }
+  return "application/octet-stream";
+}
+
 }  // namespace limn::api

@@ -8,8 +8,8 @@
 
 #include "api/json_mesh_reader.h"
 #include "api/json_util.h"
-#include "api/obj_reader.h"
 #include "api/request_parts.h"
+#include "formats/obj_reader.h"
 #include "render/mesh/content_hash.h"
 
 namespace limn::api {
@@ -32,9 +32,9 @@ BatchMesh described(const render::mesh::ControlMesh& mesh, std::string name, std
 
 BatchMesh meshFromObj(const std::string& name, const std::string& path, const std::string& text,
                       const std::string& scheme, const render::pipeline::JobLimits& limits) {
-  ObjMesh obj;
+  formats::ObjMesh obj;
   try {
-    obj = readObj(text, schemeNamed(scheme), limits.mesh);
+    obj = formats::readObj(text, schemeNamed(scheme), limits.mesh);
   } catch (const render::InputError& e) {
     throw fromInputError(e);
   }
@@ -51,6 +51,14 @@ BatchMesh meshFromJson(const std::string& name, const std::string& meshJson,
                        const render::pipeline::JobLimits& limits, render::mesh::MeshCache* meshes) {
   rapidjson::Document document;
   request::parseJson(meshJson, document);
+  // A job's meshes are read where the job is planned, in the server process: the files only
+  // Assimp reads go through a worker process as uploads instead (POST /v1/meshes).
+  if (request::readsThroughAssimp(document)) {
+    json::fail("mesh.format",
+               "a job takes its " + std::string(document["format"].GetString()) +
+                   " meshes by id: upload the file with POST /v1/meshes and give "
+                   "{\"mesh\": {\"id\": ...}} in the job (OBJ and JSON meshes may be inline)");
+  }
   std::vector<std::string> warnings;
   try {
     render::mesh::ControlMesh mesh = request::parseMesh(document, limits, warnings, meshes);

@@ -5,9 +5,9 @@
 
 #include "api/accept.h"
 #include "api/implicit_api.h"
-#include "api/mesh_export.h"
 #include "api/render_api.h"
 #include "api/request_parts.h"
+#include "formats/mesh_writers.h"
 
 namespace limn::api {
 
@@ -52,10 +52,10 @@ Answer meshAnswer(const ImplicitRequest& request, ImplicitAnswer format,
   Answer answer;
   if (format == ImplicitAnswer::Obj) {
     answer.contentType = meshMime(MeshFormat::Obj);
-    answer.body = writeObjMesh(polygonised.mesh, comments);
+    answer.body = formats::writeObjMesh(polygonised.mesh, comments);
   } else {
     answer.contentType = meshMime(MeshFormat::Ply);
-    answer.body = writePly(polygonised.mesh, comments);
+    answer.body = formats::writePly(polygonised.mesh, comments);
   }
   answer.headers.emplace_back("X-Limn-Triangles", std::to_string(polygonised.stats.triangles));
   answer.headers.emplace_back("X-Limn-Vertices", std::to_string(polygonised.stats.vertices));

@@ -4,10 +4,11 @@
 // client that draws it locally (a WebGL view while orbiting). Errors are JSON, as everywhere.
 #include <chrono>
 
+#include "api/accept.h"
 #include "api/json_util.h"
-#include "api/mesh_export.h"
 #include "api/render_api.h"
 #include "api/response_parts.h"
+#include "formats/mesh_writers.h"
 #include "render/pipeline/approximation.h"
 
 namespace limn::api {
@@ -85,13 +86,14 @@ Answer handleTessellate(std::string_view body, std::string_view accept,
     for (const std::string& w : warnings) comments.push_back("warning: " + w);
     switch (*format) {
       case MeshFormat::Glb:
-        answer.body = writeGlb(approx.mesh, extrasJson(approx, request, warnings, totalMs));
+        answer.body =
+            formats::writeGlb(approx.mesh, extrasJson(approx, request, warnings, totalMs));
         break;
       case MeshFormat::Ply:
-        answer.body = writePly(approx.mesh, comments);
+        answer.body = formats::writePly(approx.mesh, comments);
         break;
       case MeshFormat::Obj:
-        answer.body = writeObjMesh(approx.mesh, comments);
+        answer.body = formats::writeObjMesh(approx.mesh, comments);
         break;
     }
     answer.headers.emplace_back("X-Limn-Triangles", std::to_string(approx.stats.triangles));

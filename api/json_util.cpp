@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "render/core/quoted.h"
+
 namespace limn::api::json {
 
 std::string describe(const Value& value) {
@@ -29,19 +31,7 @@ std::string describe(const Value& value) {
   return "a value";
 }
 
-std::string quote(std::string_view text, size_t maxBytes) {
-  bool cut = text.size() > maxBytes;
-  size_t end = cut ? maxBytes : text.size();
-  // Never end inside a multi-byte UTF-8 sequence: back up over continuation bytes.
-  while (cut && end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
-  std::string out = "\"";
-  for (size_t i = 0; i < end; ++i) {
-    unsigned char c = static_cast<unsigned char>(text[i]);
-    out += (c < 0x20 || c == 0x7F) ? '?' : static_cast<char>(c);
-  }
-  out += cut ? "...\"" : "\"";
-  return out;
-}
+std::string quote(std::string_view text, size_t maxBytes) { return render::quoted(text, maxBytes); }
 
 std::string formatNumber(double value) {
   char text[32];

@@ -58,16 +58,31 @@ Answer handleRender(std::string_view body, const render::pipeline::JobLimits& li
                     render::mesh::MeshCache* meshes = nullptr, std::string_view accept = {});
 
 // POST /v1/tessellate: the body of a /v1/render request; answers the approximation's mesh
-// (positions, limit normals, triangles) as GLB, PLY or OBJ by `accept` (api/mesh_export.h),
-// 406 not_acceptable when the header allows none. Never throws.
+// (positions, limit normals, triangles) as GLB, PLY or OBJ by `accept` (api/accept.h,
+// formats/mesh_writers.h), 406 not_acceptable when the header allows none. Never throws.
 Answer handleTessellate(std::string_view body, std::string_view accept,
                         const render::pipeline::JobLimits& limits,
                         const render::CancelToken& cancel,
                         render::mesh::MeshCache* meshes = nullptr);
 
-// POST /v1/meshes: {"mesh": {...}} (either form) is read, validated and kept in `meshes`;
+// POST /v1/meshes: {"mesh": {...}} (any form) is read, validated and kept in `meshes`;
 // answers {"id", "vertices", "faces", "scheme", "bytes", "warnings"}. A mesh larger than the
-// whole cache is a 413 naming meshCacheBytes. Never throws.
+// whole cache is a 413 naming meshCacheBytes. Never throws. The same in two steps, for a server
+// that reads meshes in its worker processes: handleMeshImport (the worker: read and validate,
+// answering {"mesh": <the JSON form>, "warnings"}) and storeImportedMesh (the server: read that
+// back with limn's own reader and keep it; an import that failed is answered as it is).
+Answer handleMeshImport(std::string_view body, const render::pipeline::JobLimits& limits);
+Answer storeImportedMesh(const Answer& imported, const render::pipeline::JobLimits& limits,
+                         render::mesh::MeshCache& meshes);
+
+// The body of an upload as handleMeshImport reads it: a JSON body as it is; a file (its media
+// type, or any type with ?format=) wrapped as {"mesh": {"format", "dataBase64", "scheme",
+// "name"}} from the query's scheme= and name=. A media type that is neither: 415.
+struct MeshUploadQuery {
+  std::string format, scheme, name;  // as in the URL (percent-encoded)
+};
+std::string meshUploadBody(std::string_view contentType, const MeshUploadQuery& query,
+                           std::string body);
 Answer handleMeshUpload(std::string_view body, const render::pipeline::JobLimits& limits,
                         render::mesh::MeshCache& meshes);
 

@@ -7,11 +7,13 @@
 #include <initializer_list>
 #include <set>
 
+#include "api/base64.h"
 #include "api/json_mesh_reader.h"
 #include "api/json_util.h"
-#include "api/obj_reader.h"
 #include "api/render_api.h"
 #include "api/request_parts.h"
+#include "formats/assimp_import.h"
+#include "formats/obj_reader.h"
 #include "render/mesh/mesh_cache.h"
 
 namespace limn::api {
@@ -238,6 +240,59 @@ render::mesh::ControlMesh storedMesh(const Value& mesh, render::mesh::MeshCache*
   return *found;
 }
 
+namespace {
+
+// The bytes of a mesh file: mesh.data (text) or mesh.dataBase64 (any file, binary ones too).
+std::string meshFileBytes(const Value& mesh, std::string_view format) {
+  const Value* text = json::find(mesh, "data");
+  const Value* encoded = json::find(mesh, "dataBase64");
+  if (text && encoded) json::fail("mesh.dataBase64", "give mesh.data or mesh.dataBase64, not both");
+  if (text) return std::string(json::string(*text, "mesh.data"));
+  if (!encoded) {
+    json::fail("mesh.data",
+               "mesh.data (the file as text) or mesh.dataBase64 (the file in "
+               "base64) is required with format " +
+                   json::quote(format));
+  }
+  std::optional<std::vector<unsigned char>> bytes =
+      decodeBase64(json::string(*encoded, "mesh.dataBase64"));
+  if (!bytes) json::fail("mesh.dataBase64", "mesh.dataBase64 is not base64");
+  return std::string(bytes->begin(), bytes->end());
+}
+
+// A file Assimp reads (formats/assimp_import.h), with what the import did as warnings: the
+// scheme it chose, the meshes it merged, the corners it welded.
+render::mesh::ControlMesh importMeshFile(const Value& mesh, formats::ImportFormat format,
+                                         const JobLimits& limits,
+                                         std::vector<std::string>& warnings) {
+  warnUnknownFields(mesh, "mesh", {"format", "data", "dataBase64", "scheme", "name"}, warnings);
+  formats::ImportOptions options;
+  if (const Value* v = json::find(mesh, "scheme")) options.scheme = readScheme(*v, "mesh.scheme");
+  if (const Value* v = json::find(mesh, "name")) options.meshName = json::string(*v, "mesh.name");
+  const std::string bytes = meshFileBytes(mesh, formats::importFormatName(format));
+  formats::ImportedMesh imported = formats::importMesh(bytes, format, options, limits.mesh);
+  render::mesh::validateMesh(imported.mesh, limits.mesh);
+  std::string read = std::string("mesh read from ") + formats::importFormatName(format) + ": " +
+                     std::to_string(imported.mesh.faceCount()) + " faces, " +
+                     std::to_string(imported.mesh.vertexCount()) + " vertices";
+  if (imported.meshesMerged > 1)
+    read += ", " + std::to_string(imported.meshesMerged) + " meshes merged";
+  if (imported.verticesWelded > 0) {
+    read += ", " + std::to_string(imported.verticesWelded) + " repeated corners welded";
+  }
+  if (imported.schemeChosen) {
+    read +=
+        std::string("; scheme ") + render::mesh::schemeName(imported.mesh.scheme) +
+        (imported.mesh.scheme == render::mesh::Scheme::Loop ? " (every face is a triangle)"
+                                                            : " (not every face is a triangle)");
+  }
+  warnings.push_back(std::move(read));
+  for (std::string& w : imported.warnings) warnings.push_back("mesh " + std::move(w));
+  return std::move(imported.mesh);
+}
+
+}  // namespace
+
 render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
                                     std::vector<std::string>& warnings,
                                     render::mesh::MeshCache* meshes) {
@@ -246,21 +301,19 @@ render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
   std::string_view format = "json";
   if (const Value* v = json::find(mesh, "format")) format = json::string(*v, "mesh.format");
   if (format == "obj") {
-    warnUnknownFields(mesh, "mesh", {"format", "data", "scheme"}, warnings);
-    const Value* data = json::find(mesh, "data");
-    if (!data) json::fail("mesh.data", "mesh.data (the OBJ text) is required with format \"obj\"");
-    std::string_view text = json::string(*data, "mesh.data");
+    warnUnknownFields(mesh, "mesh", {"format", "data", "dataBase64", "scheme"}, warnings);
+    const std::string text = meshFileBytes(mesh, "obj");
     render::mesh::Scheme scheme = render::mesh::Scheme::CatmullClark;
     if (const Value* v = json::find(mesh, "scheme")) scheme = readScheme(*v, "mesh.scheme");
-    ObjMesh obj = readObj(text, scheme, limits.mesh);
+    formats::ObjMesh obj = formats::readObj(text, scheme, limits.mesh);
     for (std::string& w : obj.warnings) warnings.push_back("mesh " + std::move(w));
     return std::move(obj.mesh);
   }
   if (format == "json") {
-    if (json::find(mesh, "data")) {
+    if (json::find(mesh, "data") || json::find(mesh, "dataBase64")) {
       json::fail("mesh.data",
-                 "mesh.data is read only with format \"obj\"; the JSON form puts "
-                 "points, faceVertexCounts, faceVertexIndices, ... directly in mesh");
+                 "mesh.data is read only with a file format (\"obj\", \"glb\", ...); the JSON "
+                 "form puts points, faceVertexCounts, faceVertexIndices, ... directly in mesh");
     }
     warnUnknownFields(
         mesh, "mesh",
@@ -270,8 +323,11 @@ render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
         warnings);
     return readJsonMesh(mesh, "mesh", limits.mesh);
   }
-  json::fail("mesh.format",
-             "mesh.format must be one of \"obj\", \"json\"; got " + json::quote(format));
+  if (std::optional<formats::ImportFormat> imported = formats::importFormatNamed(format)) {
+    return importMeshFile(mesh, *imported, limits, warnings);
+  }
+  json::fail("mesh.format", "mesh.format must be one of " + request::meshFormatList() + "; got " +
+                                json::quote(format));
 }
 
 RenderRequest parseDocument(const Value& root, const JobLimits& limits,
@@ -366,6 +422,18 @@ void warnUnknownFields(const Value& object, const std::string& prefix,
                        std::initializer_list<const char*> known,
                        std::vector<std::string>& warnings) {
   api::warnUnknownFields(object, prefix, known, warnings);
+}
+
+std::string meshFormatList() {
+  std::string list = "\"obj\", \"json\"";
+  for (const std::string& name : formats::importFormatNames()) list += ", \"" + name + "\"";
+  return list;
+}
+
+bool readsThroughAssimp(const Value& mesh) {
+  const Value* format = mesh.IsObject() ? json::find(mesh, "format") : nullptr;
+  return format && format->IsString() &&
+         formats::importFormatNamed({format->GetString(), format->GetStringLength()}).has_value();
 }
 
 render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,

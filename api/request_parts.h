@@ -35,13 +35,23 @@ render::CameraSpec parseCamera(const rapidjson::Value& camera,
                                const render::pipeline::JobLimits& limits,
                                std::vector<std::string>& warnings);
 
-// The mesh in either form ("obj" or "json"), checked against limits.mesh, or {"id": ...}: one
+// The mesh in any form, checked against limits.mesh: "json" (the mesh itself), "obj" (limn's
+// reader, OpenSubdiv's tag lines), or a file Assimp reads ("glb", "gltf", "ply", "stl", "fbx",
+// "dae", "3ds", "off"; the file in mesh.data or mesh.dataBase64, mesh.name picks one of its
+// meshes, the scheme chosen from the faces unless mesh.scheme names it); or {"id": ...}: one
 // uploaded before and held by `meshes` (404 unknown_mesh when it is not there, or there is no
 // cache).
 render::mesh::ControlMesh parseMesh(const rapidjson::Value& mesh,
                                     const render::pipeline::JobLimits& limits,
                                     std::vector<std::string>& warnings,
                                     render::mesh::MeshCache* meshes = nullptr);
+
+// "\"obj\", \"json\", \"gltf\", ...": every mesh.format, for messages.
+std::string meshFormatList();
+
+// Whether `mesh` is a file only Assimp reads: such a mesh is read in a worker process, never in
+// the server's own (a job's spec takes it as an uploaded mesh's id instead).
+bool readsThroughAssimp(const rapidjson::Value& mesh);
 
 // params.presubdivide, searchSteps, curveSamples and contour, where present, into `out`.
 void parseSilhouetteParams(const rapidjson::Value& params,

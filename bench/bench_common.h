@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "render/mesh/control_mesh.h"
 #include "render/pipeline/render_job.h"
 
@@ -37,7 +37,7 @@ inline std::optional<render::mesh::ControlMesh> readShape(const std::filesystem:
   if (!file) return std::nullopt;
   std::stringstream text;
   text << file.rdbuf();
-  return api::readObj(text.str(), schemeOfShape(name), {}).mesh;
+  return formats::readObj(text.str(), schemeOfShape(name), {}).mesh;
 }
 
 // The fastest (totalMs) of `repeat` runs after a warm-up; `beforeEach` runs before every one

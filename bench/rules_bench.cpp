@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "render/rules/limit.h"
 #include "render/rules/refine.h"
 #include "render/subdiv/limit_surface.h"
@@ -125,7 +125,7 @@ std::vector<NamedMesh> loadMeshes(const Config& config) {
     std::ostringstream text;
     text << file.rdbuf();
     Scheme scheme = std::string(name).rfind("loop_", 0) == 0 ? Scheme::Loop : Scheme::CatmullClark;
-    meshes.push_back({name, api::readObj(text.str(), scheme, {}).mesh});
+    meshes.push_back({name, formats::readObj(text.str(), scheme, {}).mesh});
   }
   meshes.push_back({"torus 40x25 (own)", testing::torus(40, 25, false)});
   meshes.push_back({"torus 12x8 creased (own)", testing::torus(12, 8, true)});

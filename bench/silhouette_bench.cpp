@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "render/metrics/metrics.h"
 #include "render/oracle/reference.h"
 #include "render/raster/rasterizer.h"
@@ -61,7 +61,7 @@ std::vector<Shape> loadShapes(const std::vector<std::string>& only) {
     std::stringstream text;
     text << file.rdbuf();
     auto scheme = name.rfind("loop_", 0) == 0 ? mesh::Scheme::Loop : mesh::Scheme::CatmullClark;
-    shapes.push_back({name, api::readObj(text.str(), scheme, {}).mesh});
+    shapes.push_back({name, formats::readObj(text.str(), scheme, {}).mesh});
   }
   if (!only.empty()) {
     std::erase_if(shapes, [&](const Shape& s) {

@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "render/core/parallel.h"
 #include "render/subdiv/far_point.h"
 #include "render/subdiv/limit_surface.h"
@@ -53,7 +53,7 @@ ControlMesh example(const std::string& file, render::mesh::Scheme scheme) {
   std::ifstream in(std::string(LIMN_SOURCE_DIR) + "/examples/" + file);
   std::ostringstream text;
   text << in.rdbuf();
-  return api::readObj(text.str(), scheme, {}).mesh;
+  return formats::readObj(text.str(), scheme, {}).mesh;
 }
 
 std::vector<NamedMesh> meshes() {

@@ -47,3 +47,11 @@ find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
 
 # CLI11 (header only): the options of `limn batch`.
 find_package(CLI11 2.1 CONFIG REQUIRED)
+
+# Assimp (formats/: mesh files in): Debian's assimpTargets.cmake names draco::draco and minizip
+# targets that its package does not define, so the imported target is made by hand.
+find_path(ASSIMP_INCLUDE_DIR assimp/Importer.hpp REQUIRED)
+find_library(ASSIMP_LIBRARY assimp REQUIRED)
+add_library(assimp_lib INTERFACE)
+target_include_directories(assimp_lib INTERFACE ${ASSIMP_INCLUDE_DIR})
+target_link_libraries(assimp_lib INTERFACE ${ASSIMP_LIBRARY})

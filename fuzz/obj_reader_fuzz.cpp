@@ -1,5 +1,5 @@
 // The OBJ reader with OpenSubdiv's tag lines: scan, tinyobjloader, tags, validateMesh().
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "fuzz/fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -9,8 +9,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const Scheme schemes[] = {Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear};
   const Scheme scheme = schemes[data[0] % 3];
   limn::fuzz::expectOnlyDocumentedErrors([&] {
-    limn::api::readObj(limn::fuzz::asText(data + 1, size - 1), scheme,
-                       limn::fuzz::defaultLimits().mesh);
+    limn::formats::readObj(limn::fuzz::asText(data + 1, size - 1), scheme,
+                           limn::fuzz::defaultLimits().mesh);
   });
   return 0;
 }

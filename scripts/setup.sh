@@ -25,6 +25,8 @@ packages=(
   libcli11-dev
   # the job store's two backends (batch/job_store.h)
   libsqlite3-dev libpq-dev
+  # mesh files in: glTF, PLY, STL, FBX, COLLADA, 3DS, OFF (formats/assimp_import.h)
+  libassimp-dev
 )
 if [ "$profile" = full ]; then
   packages+=(

@@ -154,7 +154,8 @@ void Connection::handle() {
                   requestId_,
                   std::string(message["Idempotency-Key"]),
                   peerAddress(),
-                  std::string(message["Priority"])};
+                  std::string(message["Priority"]),
+                  std::string(message[http::field::content_type])};
   // The router may answer from a worker thread: hop back onto this connection's strand.
   const unsigned generation = ++handling_;
   abandon_ = shared_.router.handle(

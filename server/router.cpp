@@ -39,7 +39,7 @@ const Router::Route Router::kRoutes[] = {
     {"POST", "/v1/tessellate", &Router::compute, Endpoint::Tessellate},
     {"POST", "/v1/implicit", &Router::compute, Endpoint::Implicit},
     {"POST", "/v1/compare", &Router::compute, Endpoint::Compare},
-    {"POST", "/v1/meshes", &Router::uploadMesh},
+    {"POST", "/v1/meshes", &Router::uploadMesh, Endpoint::ImportMesh},
     {"POST", "/v1/jobs", &Router::createJob},
     {"GET", "/v1/jobs", &Router::listJobs},
     {"GET", "/v1/jobs/{id}", &Router::getJob},
@@ -225,20 +225,33 @@ WorkerPool::Abandon Router::compute(const Route& route, Request& request, Reply&
                       std::move(reply), request.id, std::move(jobClass));
 }
 
-// Parsing a large mesh takes a while: it runs on a worker's thread like a render (same queue,
-// limits and deadline), in the server, whose cache keeps the mesh.
-WorkerPool::Abandon Router::uploadMesh(const Route&, Request& request, Reply& reply) {
+// A mesh is read like a render's: in a worker process (Assimp's importers above all must not
+// take the server down), with the same queue, limits and deadline. The worker answers the mesh in
+// limn's JSON form; the server reads that back with its own reader and keeps it in its cache.
+WorkerPool::Abandon Router::uploadMesh(const Route& route, Request& request, Reply& reply) {
   if (!meshes_) {
     return answerNow(reply,
                      api::errorAnswer({404, "not_found", "this server keeps no uploaded meshes",
                                        api::json::detailObject({{"path", "/v1/meshes"}})}));
   }
-  return pool_.submitInServer(
-      [body = std::move(request.body), limits = limits_, meshes = meshes_](
-          render::pipeline::RenderContext&, const render::CancelToken&) {
-        return api::handleMeshUpload(body, limits, *meshes);
+  std::string body;
+  try {
+    body = api::meshUploadBody(
+        request.contentType,
+        {queryParameter(request.target, "format"), queryParameter(request.target, "scheme"),
+         queryParameter(request.target, "name")},
+        std::move(request.body));
+  } catch (const api::ApiError& error) {
+    return answerNow(reply, api::errorAnswer(error));
+  }
+  request.body = std::move(body);
+  JobClass jobClass = classify(route, request);
+  return pool_.submit(
+      Task{Endpoint::ImportMesh, std::move(request.body)},
+      [reply = std::move(reply), limits = limits_, meshes = meshes_](api::Answer imported) {
+        reply(api::storeImportedMesh(imported, limits, *meshes));
       },
-      std::move(reply), clientOf(request.authorization, request.peer));
+      request.id, std::move(jobClass));
 }
 
 // A job's spec (its meshes) is read on a worker's thread, like an upload; its state and

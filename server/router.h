@@ -47,6 +47,7 @@ struct Request {
   std::string idempotencyKey = {};  // the Idempotency-Key header ("" when absent): POST /v1/jobs
   std::string peer = {};            // the client's address ("" in tests without a socket)
   std::string priority = {};        // the Priority header (RFC 9218): "u=6" or "u=7" is batch
+  std::string contentType = {};     // the Content-Type header: POST /v1/meshes takes mesh files
 };
 
 class Router {

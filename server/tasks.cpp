@@ -23,12 +23,16 @@ api::Answer runTask(const Task& task, const render::pipeline::JobLimits& limits,
       return api::handleImplicit(task.body, task.accept, limits, context, cancel);
     case Endpoint::Compare:
       return api::handleCompare(task.body, limits, context, cancel, meshes);
+    case Endpoint::ImportMesh:
+      return api::handleMeshImport(task.body, limits);
   }
   return api::errorAnswer({500, "internal", "unknown task endpoint"});
 }
 
 std::optional<std::string> referencedMeshId(const Task& task) {
-  if (task.endpoint == Endpoint::Implicit) return std::nullopt;
+  if (task.endpoint == Endpoint::Implicit || task.endpoint == Endpoint::ImportMesh) {
+    return std::nullopt;
+  }
   return api::referencedMeshId(task.body);
 }
 
@@ -44,6 +48,8 @@ const char* endpointPath(Endpoint endpoint) {
       return "/v1/implicit";
     case Endpoint::Compare:
       return "/v1/compare";
+    case Endpoint::ImportMesh:
+      return "/v1/meshes";
   }
   return "?";
 }

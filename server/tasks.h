@@ -16,7 +16,9 @@
 
 namespace limn::server {
 
-enum class Endpoint : uint8_t { Render, Silhouette, Tessellate, Implicit, Compare };
+// ImportMesh: POST /v1/meshes' reading of the mesh (api::handleMeshImport); the server keeps
+// what it answers (api::storeImportedMesh).
+enum class Endpoint : uint8_t { Render, Silhouette, Tessellate, Implicit, Compare, ImportMesh };
 
 struct Task {
   Endpoint endpoint = Endpoint::Render;

@@ -30,7 +30,7 @@
 #include <thread>
 #include <vector>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "render/core/error.h"
 #include "tests/integration/http_client.h"
 #include "tests/integration/json_answer.h"
@@ -106,7 +106,7 @@ std::string judge(const HttpResponse& r, const RequestVariant& v, const Generate
   return "";
 }
 
-// The generator's OBJ text is what it claims: api::readObj reads it back as exactly the mesh,
+// The generator's OBJ text is what it claims: formats::readObj reads it back as exactly the mesh,
 // and refuses the meshes made invalid on purpose.
 TEST(GeneratedMeshes, ObjTextReadsBackAsTheMesh) {
   const render::mesh::MeshLimits limits;
@@ -115,13 +115,13 @@ TEST(GeneratedMeshes, ObjTextReadsBackAsTheMesh) {
     const GeneratedMesh g = generateMesh(seed);
     SCOPED_TRACE(g.description);
     if (!g.refusal.empty()) {
-      EXPECT_THROW(api::readObj(g.obj, g.mesh.scheme, limits), render::InputError);
+      EXPECT_THROW(formats::readObj(g.obj, g.mesh.scheme, limits), render::InputError);
       ++refused;
       continue;
     }
-    api::ObjMesh read;
+    formats::ObjMesh read;
     try {
-      read = api::readObj(g.obj, g.mesh.scheme, limits);
+      read = formats::readObj(g.obj, g.mesh.scheme, limits);
     } catch (const std::exception& e) {
       ADD_FAILURE() << "the OBJ reader refused it: " << e.what();
       continue;

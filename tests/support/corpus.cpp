@@ -4,7 +4,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 
 #ifndef LIMN_SOURCE_DIR
 #error "LIMN_SOURCE_DIR must name the repository"
@@ -45,7 +45,7 @@ std::optional<render::mesh::ControlMesh> readCorpusMesh(
     const fs::path& path, std::optional<render::mesh::Scheme> scheme) {
   if (!fs::exists(path)) return std::nullopt;
   const render::mesh::Scheme chosen = scheme.value_or(corpusScheme(path.filename().string()));
-  return api::readObj(readTextFile(path), chosen, render::mesh::MeshLimits{}).mesh;
+  return formats::readObj(readTextFile(path), chosen, render::mesh::MeshLimits{}).mesh;
 }
 
 std::optional<render::mesh::ControlMesh> readCorpusShape(const std::string& name) {

@@ -22,7 +22,7 @@ render::mesh::Scheme corpusScheme(std::string_view fileName);
 std::string readTextFile(const std::filesystem::path& path);
 
 // The mesh in `path` (scheme from its name unless given), read and validated by
-// api::readObj with the default limits; nullopt when the file does not exist. Throws
+// formats::readObj with the default limits; nullopt when the file does not exist. Throws
 // render::InputError for a file the reader refuses.
 std::optional<render::mesh::ControlMesh> readCorpusMesh(
     const std::filesystem::path& path, std::optional<render::mesh::Scheme> scheme = {});

@@ -8,7 +8,7 @@
 #include <set>
 #include <utility>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 
 namespace limn::testing {
 
@@ -890,7 +890,7 @@ GeneratedMesh generateMesh(ChoiceSource& c, const GeneratorOptions& options) {
   // to 17 digits may come back an ulp or so away. The mesh's points are what the reader reads.
   MeshLimits unlimited;
   unlimited.maxVertices = mesh.vertexCount();
-  mesh.points = api::parseObj(vertexLines, mesh.scheme, unlimited).mesh.points;
+  mesh.points = formats::parseObj(vertexLines, mesh.scheme, unlimited).mesh.points;
   return out;
 }
 

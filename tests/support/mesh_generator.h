@@ -8,7 +8,7 @@
 // and bilinear.
 //
 // Each mesh comes as a render::mesh::ControlMesh and as the OBJ text (with OpenSubdiv's `t` tag
-// lines, written in the varied forms limn's OBJ reader accepts) that api::readObj reads back
+// lines, written in the varied forms limn's OBJ reader accepts) that formats::readObj reads back
 // as exactly that ControlMesh, so the same mesh can go through the HTTP API. A few meshes in a
 // hundred are invalid on purpose (a crease off the mesh's edges, a face over maxFaceSize, a
 // vertex over maxValence, a quad for Loop, ...): `refusal` says why, and limn must refuse them
@@ -99,7 +99,7 @@ struct GeneratorOptions {
 
 struct GeneratedMesh {
   render::mesh::ControlMesh mesh;
-  std::string obj;  // reads back (api::readObj) as `mesh`, unless `refusal` is set
+  std::string obj;  // reads back (formats::readObj) as `mesh`, unless `refusal` is set
   // What it is made of, for failure messages: "loop: fan(valence 300) book(17 pages) ...".
   std::string description;
   // Non-empty: the mesh is invalid on purpose and this says how ("crease off the edges"); the

@@ -10,14 +10,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "api/accept.h"
 #include "api/base64.h"
 #include "api/config.h"
 #include "api/json_mesh_reader.h"
-#include "api/mesh_export.h"
-#include "api/obj_reader.h"
 #include "api/openapi.h"
 #include "api/render_api.h"
 #include "api/work_estimate.h"
+#include "formats/mesh_writers.h"
+#include "formats/obj_reader.h"
 #include "render/raster/rasterizer.h"
 #include "tests/support/corpus.h"
 
@@ -99,17 +100,17 @@ using limn::testing::corpusDir;
 std::string readFile(const fs::path& path) { return limn::testing::readTextFile(path); }
 Scheme schemeOfCorpusFile(const std::string& name) { return limn::testing::corpusScheme(name); }
 
-api::ObjMesh readCorpus(const std::string& name) {
+formats::ObjMesh readCorpus(const std::string& name) {
   fs::path path = corpusDir() / (name + ".obj");
   if (!fs::exists(path)) throw std::runtime_error("missing corpus file " + path.string());
-  return api::parseObj(readFile(path), schemeOfCorpusFile(name), {});
+  return formats::parseObj(readFile(path), schemeOfCorpusFile(name), {});
 }
 
 // The InputError readObj throws for `obj`.
 InputError objError(const std::string& obj, Scheme scheme = Scheme::CatmullClark,
                     render::mesh::MeshLimits limits = {}) {
   try {
-    api::readObj(obj, scheme, limits);
+    formats::readObj(obj, scheme, limits);
   } catch (const InputError& error) {
     return error;
   }
@@ -169,7 +170,7 @@ TEST(ErrorAnswer, HasCodeMessageAndDetail) {
 // OBJ reader
 
 TEST(ObjReader, ReadsCubeWithDefaultEdgeOnlyBoundary) {
-  api::ObjMesh obj = api::readObj(kCubeObj, Scheme::CatmullClark, {});
+  formats::ObjMesh obj = formats::readObj(kCubeObj, Scheme::CatmullClark, {});
   const ControlMesh& m = obj.mesh;
   EXPECT_EQ(m.vertexCount(), 8);
   EXPECT_EQ(m.faceCount(), 6);
@@ -201,7 +202,7 @@ TEST(ObjReader, EveryCorpusFileParsesWithItsCounts) {
       if (line.rfind("t crease ", 0) == 0) creasePairs += std::atoi(line.c_str() + 9) / 2;
     }
     try {
-      api::ObjMesh obj = api::parseObj(text, schemeOfCorpusFile(name), {});
+      formats::ObjMesh obj = formats::parseObj(text, schemeOfCorpusFile(name), {});
       EXPECT_EQ(obj.mesh.vertexCount(), vertices) << name;
       EXPECT_EQ(obj.mesh.faceCount(), faces) << name;
       EXPECT_EQ(static_cast<int>(obj.mesh.creases.size()), creasePairs) << name;
@@ -223,7 +224,7 @@ TEST(ObjReader, EveryCorpusFileIsAcceptedOrRefusedWithAClearError) {
     if (entry.path().extension() != ".obj") continue;
     std::string name = entry.path().stem().string();
     try {
-      api::readObj(readFile(entry.path()), schemeOfCorpusFile(name), {});
+      formats::readObj(readFile(entry.path()), schemeOfCorpusFile(name), {});
     } catch (const InputError& error) {
       EXPECT_NE(name.find("nonman"), std::string::npos) << name << ": " << error.what();
       EXPECT_EQ(error.subject().rfind("face ", 0), 0u) << name << ": " << error.what();
@@ -234,7 +235,7 @@ TEST(ObjReader, EveryCorpusFileIsAcceptedOrRefusedWithAClearError) {
 
 TEST(ObjReader, CorpusTagsHaveTheirExactValues) {
   if (!fs::exists(corpusDir())) GTEST_SKIP() << "no corpus at " << corpusDir();
-  api::ObjMesh creases = readCorpus("catmark_cube_creases0");
+  formats::ObjMesh creases = readCorpus("catmark_cube_creases0");
   ASSERT_EQ(creases.mesh.creases.size(), 2u);
   EXPECT_EQ(creases.mesh.creases[0].v0, 0);
   EXPECT_EQ(creases.mesh.creases[0].v1, 1);
@@ -243,11 +244,11 @@ TEST(ObjReader, CorpusTagsHaveTheirExactValues) {
   EXPECT_EQ(creases.mesh.creases[1].v1, 3);
   EXPECT_EQ(creases.mesh.boundary, BoundaryInterpolation::EdgeOnly);
 
-  api::ObjMesh hole = readCorpus("catmark_hole_test1");
+  formats::ObjMesh hole = readCorpus("catmark_hole_test1");
   EXPECT_EQ(hole.mesh.holes, std::vector<int>{1});
   EXPECT_EQ(hole.holeLines.size(), 1u);
 
-  api::ObjMesh corner = readCorpus("catmark_cube_corner0");
+  formats::ObjMesh corner = readCorpus("catmark_cube_corner0");
   ASSERT_EQ(corner.mesh.corners.size(), 1u);
   EXPECT_EQ(corner.mesh.corners[0].vertex, 0);
   EXPECT_FLOAT_EQ(corner.mesh.corners[0].sharpness, 0.7f);
@@ -259,7 +260,7 @@ TEST(ObjReader, CorpusTagsHaveTheirExactValues) {
   EXPECT_EQ(readCorpus("catmark_smoothtris0").mesh.triangleSubdivision,
             render::mesh::TriangleSubdivision::CatmullClark);
 
-  api::ObjMesh loop = readCorpus("loop_cube_creases0");
+  formats::ObjMesh loop = readCorpus("loop_cube_creases0");
   ASSERT_EQ(loop.mesh.creases.size(), 2u);
   EXPECT_FLOAT_EQ(loop.mesh.creases[1].sharpness, 2.8f);
   EXPECT_EQ(loop.mesh.creases[1].v0, 3);
@@ -276,7 +277,7 @@ TEST(ObjReader, ReadsAllTagForms) {
                     "t interpolateboundary 1/0/0 0\n"
                     "t creasemethod 0/0/1 chaikin\n"
                     "t smoothtriangles 0/0/1 smooth\n";
-  api::ObjMesh out = api::readObj(obj, Scheme::CatmullClark, {});
+  formats::ObjMesh out = formats::readObj(obj, Scheme::CatmullClark, {});
   const ControlMesh& m = out.mesh;
   ASSERT_EQ(m.creases.size(), 4u);
   EXPECT_FLOAT_EQ(m.creases[1].sharpness, 1.5f);
@@ -292,7 +293,7 @@ TEST(ObjReader, ReadsAllTagForms) {
   EXPECT_EQ(m.creaseMethod, render::mesh::CreaseMethod::Chaikin);
   EXPECT_EQ(m.triangleSubdivision, render::mesh::TriangleSubdivision::Smooth);
   for (int boundary : {1, 2}) {
-    api::ObjMesh b = api::readObj(
+    formats::ObjMesh b = formats::readObj(
         std::string(kCubeObj) + "t interpolateboundary 1/0/0 " + std::to_string(boundary) + "\n",
         Scheme::CatmullClark, {});
     EXPECT_EQ(b.mesh.boundary, boundary == 1 ? BoundaryInterpolation::EdgeAndCorner
@@ -306,7 +307,7 @@ TEST(ObjReader, KeepsTagsAfterATrailingGroupAndHandlesGroupsAndLineEndings) {
       "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\r\n"
       "g first\nf 1 2 3\ng second\nusemtl red\nf -4 -2 -1\r\n"
       "g trailing\rt crease 2/1/0 0 1 3.0\n";
-  api::ObjMesh out = api::readObj(obj, Scheme::CatmullClark, {});
+  formats::ObjMesh out = formats::readObj(obj, Scheme::CatmullClark, {});
   EXPECT_EQ(out.mesh.faceCount(), 2);
   EXPECT_EQ(out.mesh.faceVertexIndices, (std::vector<int>{0, 1, 2, 0, 2, 3}));
   ASSERT_EQ(out.mesh.creases.size(), 1u);
@@ -319,7 +320,7 @@ TEST(ObjReader, IgnoresTexturesNormalsAndWarnsOnUnknownTags) {
       "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\n"
       "s off\no thing\nmtllib x.mtl\nf 1/1/1 2/2/1 3/3/1\nl 1 2\n"
       "t facevaryingpropagatecorners 1/0/0 1\n";
-  api::ObjMesh out = api::readObj(obj, Scheme::Loop, {});
+  formats::ObjMesh out = formats::readObj(obj, Scheme::Loop, {});
   EXPECT_EQ(out.mesh.faceCount(), 1);
   ASSERT_EQ(out.warnings.size(), 2u);
   EXPECT_TRUE(contains(out.warnings[0], "line 12")) << out.warnings[0];
@@ -356,7 +357,7 @@ TEST(ObjReader, BadIndicesNameTheLine) {
   InputError slashes = objError(tri + "f 1/1/1/1 2 3\n");
   EXPECT_EQ(slashes.subject(), "line 4");
   // A face that repeats a vertex is non-manifold, not malformed: OpenSubdiv takes it.
-  EXPECT_NO_THROW(api::readObj(tri + "f 1 2 2\n", render::mesh::Scheme::CatmullClark, {}));
+  EXPECT_NO_THROW(formats::readObj(tri + "f 1 2 2\n", render::mesh::Scheme::CatmullClark, {}));
 }
 
 TEST(ObjReader, BadCoordinatesNameTheLine) {
@@ -371,18 +372,18 @@ TEST(ObjReader, BadCoordinatesNameTheLine) {
   EXPECT_TRUE(contains(objError("v 1 0 abc\n").what(), "not a decimal number"));
   EXPECT_EQ(objError("v 1 0\n").subject(), "line 1");  // tinyobjloader would make z = 0
   // Valid forms of numbers are read as numbers.
-  api::ObjMesh ok =
-      api::readObj("v +1.5e2 -.5 7.\nv 1 0 0 1\nv 1 1 0 0.5 0.5 0.5\nf 1 2 3\n", Scheme::Loop, {});
+  formats::ObjMesh ok = formats::readObj(
+      "v +1.5e2 -.5 7.\nv 1 0 0 1\nv 1 1 0 0.5 0.5 0.5\nf 1 2 3\n", Scheme::Loop, {});
   EXPECT_DOUBLE_EQ(ok.mesh.points[0].x, 150.0);
   EXPECT_DOUBLE_EQ(ok.mesh.points[0].y, -0.5);
   EXPECT_DOUBLE_EQ(ok.mesh.points[0].z, 7.0);
   // Read in double precision (a float reader would keep 7 digits).
-  api::ObjMesh precise =
-      api::readObj("v 123456789.125 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
+  formats::ObjMesh precise =
+      formats::readObj("v 123456789.125 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
   EXPECT_NEAR(precise.mesh.points[0].x, 123456789.125, 1e-6);  // float: off by 3
   // Finite in double but beyond what limn renders (render::mesh::kMaxCoordinate): line named.
   try {
-    api::readObj("v 1e300 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
+    formats::readObj("v 1e300 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", Scheme::Loop, {});
     ADD_FAILURE() << "1e300 was accepted";
   } catch (const render::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("line 1"), std::string::npos) << e.what();
@@ -481,7 +482,8 @@ TEST(JsonMeshReader, CubeEqualsTheObjCube) {
   std::string tags =
       "t crease 2/1/0 0 1 2.5\nt corner 1/1/0 7 1.5\nt hole 1/0/0 2\n"
       "t interpolateboundary 1/0/0 1\nt creasemethod 0/0/1 chaikin\n";
-  ControlMesh fromObj = api::readObj(std::string(kCubeObj) + tags, Scheme::CatmullClark, {}).mesh;
+  ControlMesh fromObj =
+      formats::readObj(std::string(kCubeObj) + tags, Scheme::CatmullClark, {}).mesh;
   std::string json = kCubeJsonMesh;
   json.pop_back();
   json += R"(, "creaseIndices": [0, 1], "creaseLengths": [2], "creaseSharpnesses": [2.5],
@@ -717,7 +719,7 @@ TEST(RenderRequest, WrongTypesNameTheField) {
   expectError(root, 400, "invalid_request");
   ApiError noMesh = parseError(R"({"method": "coarse"})");
   EXPECT_EQ(detailMember(noMesh, "field"), "mesh");
-  ApiError format = parseError(R"({"mesh": {"format": "stl", "data": ""}})");
+  ApiError format = parseError(R"({"mesh": {"format": "step", "data": ""}})");
   EXPECT_EQ(detailMember(format, "field"), "mesh.format");
   ApiError data = parseError(R"({"mesh": {"format": "obj", "data": 5}})");
   EXPECT_EQ(detailMember(data, "field"), "mesh.data");
@@ -1283,21 +1285,21 @@ TEST(MeshExport, ObjAndPlyCarryEveryVertexNormalAndTriangle) {
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
   mesh.normals.assign(4, {0, 0, 1});
   mesh.indices = {0, 1, 2, 2, 1, 3};
-  const std::string obj = api::writeObjMesh(mesh, {"two triangles"});
+  const std::string obj = formats::writeObjMesh(mesh, {"two triangles"});
   EXPECT_EQ(obj.rfind("# two triangles\nv 0 0 0\n", 0), 0u);
   EXPECT_TRUE(contains(obj, "vn 0 0 1\n"));
   EXPECT_TRUE(contains(obj, "f 1//1 2//2 3//3\nf 3//3 2//2 4//4\n"));
-  const std::string ply = api::writePly(mesh, {"x"});
+  const std::string ply = formats::writePly(mesh, {"x"});
   EXPECT_TRUE(contains(ply, "comment x\nelement vertex 4\n"));
   EXPECT_TRUE(contains(ply, "element face 2\n"));
   EXPECT_EQ(ply.size() - (ply.find("end_header\n") + 11), 4u * 24 + 2u * 13);
-  const std::string glb = api::writeGlb(mesh, R"({"note":1})");
+  const std::string glb = formats::writeGlb(mesh, R"({"note":1})");
   EXPECT_EQ(glb.substr(0, 4), "glTF");
   EXPECT_EQ(glb.size() % 4, 0u);
   EXPECT_TRUE(contains(glb, R"("extras":{"note":1})"));
   EXPECT_TRUE(contains(glb, R"("min":[0,0,0],"max":[1,1,0])"));
   // No triangles: a valid file with an empty scene.
-  const std::string empty = api::writeGlb({}, "");
+  const std::string empty = formats::writeGlb({}, "");
   EXPECT_TRUE(contains(empty, R"("scenes":[{"nodes":[]}])"));
   EXPECT_FALSE(contains(empty, "BIN"));
 }

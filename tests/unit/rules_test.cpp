@@ -15,7 +15,7 @@
 #include <random>
 #include <sstream>
 
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 #include "render/core/error.h"
 #include "render/rules/halfedge_level.h"
 #include "render/rules/limit.h"

@@ -15,7 +15,7 @@
 
 #include "render/mesh/control_mesh.h"
 
-namespace limn::api {
+namespace limn::formats {
 
 struct ObjMesh {
   render::mesh::ControlMesh mesh;
@@ -41,4 +41,4 @@ ObjMesh parseObj(std::string_view text, render::mesh::Scheme scheme,
 // to the message.
 void validateObjMesh(const ObjMesh& obj, const render::mesh::MeshLimits& limits);
 
-}  // namespace limn::api
+}  // namespace limn::formats

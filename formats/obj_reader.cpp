@@ -1,15 +1,15 @@
-#include "api/obj_reader.h"
+#include "formats/obj_reader.h"
 
 #include <tiny_obj_loader.h>
 
 #include <cstdlib>
 #include <stdexcept>
 
-#include "api/json_util.h"
-#include "api/obj_scan.h"
+#include "formats/obj_scan.h"
 #include "render/core/error.h"
+#include "render/core/quoted.h"
 
-namespace limn::api {
+namespace limn::formats {
 
 namespace {
 
@@ -19,7 +19,7 @@ using namespace render::mesh;
 [[noreturn]] void badTag(const ObjTag& tag, const std::string& message) {
   std::string subject = "line " + std::to_string(tag.line);
   throw InputError(InputError::Kind::InvalidMesh, subject,
-                   subject + ": tag " + json::quote(tag.name) + " " + message);
+                   subject + ": tag " + render::quoted(tag.name) + " " + message);
 }
 
 std::string sizeTriple(const ObjTag& tag) {
@@ -93,7 +93,7 @@ void applyTag(const ObjTag& tag, ObjMesh& out) {
     mesh.triangleSubdivision =
         value == "smooth" ? TriangleSubdivision::Smooth : TriangleSubdivision::CatmullClark;
   } else {
-    out.warnings.push_back("line " + std::to_string(tag.line) + ": tag " + json::quote(name) +
+    out.warnings.push_back("line " + std::to_string(tag.line) + ": tag " + render::quoted(name) +
                            " is not supported and was ignored");
   }
 }
@@ -201,4 +201,4 @@ ObjMesh parseObj(std::string_view text, Scheme scheme, const MeshLimits& limits)
   return out;
 }
 
-}  // namespace limn::api
+}  // namespace limn::formats

@@ -11,7 +11,7 @@
 
 #include "render/mesh/control_mesh.h"
 
-namespace limn::api {
+namespace limn::formats {
 
 struct ObjTag {
   int line = 0;
@@ -32,4 +32,4 @@ struct ObjScan {
 // maxVertices, maxFaces or maxFaceSize).
 ObjScan scanObj(std::string_view text, const render::mesh::MeshLimits& limits);
 
-}  // namespace limn::api
+}  // namespace limn::formats

@@ -1,4 +1,4 @@
-#include "api/obj_scan.h"
+#include "formats/obj_scan.h"
 
 #include <charconv>
 #include <climits>
@@ -7,10 +7,10 @@
 #include <set>
 #include <system_error>
 
-#include "api/json_util.h"
 #include "render/core/error.h"
+#include "render/core/quoted.h"
 
-namespace limn::api {
+namespace limn::formats {
 
 namespace {
 
@@ -76,8 +76,8 @@ double parseNumber(std::string_view token, int line, const char* what) {
     if (error == std::errc() && end == digits.data() + digits.size()) return value;
     value = std::strtod(std::string(token).c_str(), nullptr);
     if (!std::isfinite(value)) {
-      syntax(line,
-             std::string(what) + " " + json::quote(token) + " is not finite (overflows a double)");
+      syntax(line, std::string(what) + " " + render::quoted(token) +
+                       " is not finite (overflows a double)");
     }
     return value;
   }
@@ -85,9 +85,9 @@ double parseNumber(std::string_view token, int line, const char* what) {
   char* end = nullptr;
   double value = std::strtod(text.c_str(), &end);
   if (end == text.c_str() + text.size() && !std::isfinite(value)) {
-    syntax(line, std::string(what) + " " + json::quote(token) + " is not finite");
+    syntax(line, std::string(what) + " " + render::quoted(token) + " is not finite");
   }
-  syntax(line, std::string(what) + " " + json::quote(token) + " is not a decimal number");
+  syntax(line, std::string(what) + " " + render::quoted(token) + " is not a decimal number");
 }
 
 // [+-]? digits within int range.
@@ -130,12 +130,12 @@ class Scanner {
     if (kIgnoredWithWarning.count(keyword)) {
       if (warned_.insert(std::string(keyword)).second) {
         scan_.warnings.push_back("line " + std::to_string(number) + ": OBJ statement " +
-                                 json::quote(keyword) +
+                                 render::quoted(keyword) +
                                  " is not used by limn and was ignored (here and later)");
       }
       return;
     }
-    syntax(number, "unknown OBJ statement " + json::quote(keyword));
+    syntax(number, "unknown OBJ statement " + render::quoted(keyword));
   }
 
   ObjScan take() { return std::move(scan_); }
@@ -192,7 +192,7 @@ class Scanner {
         if (p == 0) index = value;
       }
       if (!ok) {
-        syntax(line, face + ": " + json::quote(token) +
+        syntax(line, face + ": " + render::quoted(token) +
                          " is not a vertex reference (v, v/vt, v//vn or v/vt/vn with non-zero "
                          "integer indices; OBJ indices start at 1)");
       }
@@ -225,16 +225,16 @@ class Scanner {
       std::string_view part = header.substr(
           start, slash == std::string_view::npos ? std::string_view::npos : slash - start);
       if (!parseInt(part, &counts[c]) || counts[c] < 0 || part[0] == '+' || part[0] == '-') {
-        syntax(line, "tag " + json::quote(tag.name) + " has the size triple " +
-                         json::quote(header) + ": expected nInts/nFloats/nStrings, e.g. 2/1/0");
+        syntax(line, "tag " + render::quoted(tag.name) + " has the size triple " +
+                         render::quoted(header) + ": expected nInts/nFloats/nStrings, e.g. 2/1/0");
       }
       if (slash == std::string_view::npos) break;
       start = slash + 1;
-      if (c == 2) syntax(line, "tag size triple " + json::quote(header) + " has too many parts");
+      if (c == 2) syntax(line, "tag size triple " + render::quoted(header) + " has too many parts");
     }
     size_t expected = static_cast<size_t>(counts[0]) + counts[1] + counts[2];
     if (tokens.size() - 3 != expected) {
-      syntax(line, "tag " + json::quote(tag.name) + " declares " + std::string(header) + " = " +
+      syntax(line, "tag " + render::quoted(tag.name) + " declares " + std::string(header) + " = " +
                        std::to_string(expected) + " values but the line has " +
                        std::to_string(tokens.size() - 3));
     }
@@ -242,7 +242,7 @@ class Scanner {
     for (int i = 0; i < counts[0]; ++i, ++at) {
       int value = 0;
       if (!parseInt(tokens[at], &value)) {
-        syntax(line, "tag " + json::quote(tag.name) + ": " + json::quote(tokens[at]) +
+        syntax(line, "tag " + render::quoted(tag.name) + ": " + render::quoted(tokens[at]) +
                          " is not an integer");
       }
       tag.ints.push_back(value);
@@ -283,4 +283,4 @@ ObjScan scanObj(std::string_view text, const render::mesh::MeshLimits& limits) {
   return scanner.take();
 }
 
-}  // namespace limn::api
+}  // namespace limn::formats

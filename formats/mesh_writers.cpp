@@ -1,4 +1,4 @@
-#include "api/mesh_export.h"
+#include "formats/mesh_writers.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -6,9 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#include "api/accept.h"
-
-namespace limn::api {
+namespace limn::formats {
 
 namespace {
 
@@ -38,45 +36,6 @@ std::string number(double v) {
 }
 
 }  // namespace
-
-std::optional<MeshFormat> chooseMeshFormat(std::string_view accept) {
-  if (parseAccept(accept).empty()) return MeshFormat::Glb;
-  struct Candidate {
-    const char* type;
-    MeshFormat format;
-  };
-  static constexpr Candidate kTypes[] = {{"model/gltf-binary", MeshFormat::Glb},
-                                         {"application/x-ply", MeshFormat::Ply},
-                                         {"model/ply", MeshFormat::Ply},
-                                         {"text/plain", MeshFormat::Obj},
-                                         {"model/obj", MeshFormat::Obj}};
-  std::optional<MeshFormat> best;
-  double bestQ = 0, anyQ = 0;
-  for (const MediaRange& range : parseAccept(accept)) {
-    if (range.type == "*/*" || sameMediaType(range.type, "model/*")) anyQ = std::max(anyQ, range.q);
-    for (const Candidate& c : kTypes) {
-      if (sameMediaType(range.type, c.type) && range.q > bestQ) {
-        best = c.format;
-        bestQ = range.q;
-      }
-    }
-  }
-  if (best && bestQ >= anyQ) return best;
-  if (anyQ > 0) return MeshFormat::Glb;
-  return std::nullopt;
-}
-
-const char* meshMime(MeshFormat format) {
-  switch (format) {
-    case MeshFormat::Glb:
-      return "model/gltf-binary";
-    case MeshFormat::Ply:
-      return "application/x-ply";
-    case MeshFormat::Obj:
-      return "text/plain; charset=utf-8";
-  }
-  return "application/octet-stream";
-}
 
 std::string writeGlb(const TriangleMesh& mesh, const std::string& extrasJson) {
   const size_t n = mesh.positions.size(), t = mesh.triangleCount();
@@ -217,4 +176,4 @@ std::string writeObjMesh(const TriangleMesh& mesh, const std::vector<std::string
   return out;
 }
 
-}  // namespace limn::api
+}  // namespace limn::formats

@@ -1,25 +1,16 @@
 // The approximation's mesh as a file for clients that draw it themselves (POST /v1/tessellate):
 // binary glTF 2.0 (GLB), binary PLY or OBJ, each with per-vertex positions and normals and
-// counter-clockwise triangles. Which one an Accept header asks for is chosenMeshFormat()'s
+// counter-clockwise triangles. Which one an Accept header asks for is api/accept.h's
 // business; the writers know nothing of HTTP.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "render/tessellate/triangle_mesh.h"
 
-namespace limn::api {
-
-enum class MeshFormat { Glb, Ply, Obj };
-
-// The format an Accept header ranks highest among model/gltf-binary, application/x-ply (or
-// model/ply) and text/plain (or model/obj); an absent header, or one whose best entry is */*,
-// gets GLB. Nothing acceptable (e.g. only image/png): nullopt.
-std::optional<MeshFormat> chooseMeshFormat(std::string_view accept);
-const char* meshMime(MeshFormat format);
+namespace limn::formats {
 
 // GLB with one mesh of one triangle primitive (POSITION, NORMAL when the mesh has normals,
 // 32-bit indices); `extrasJson` (a JSON object, or "") goes into asset.extras.
@@ -32,4 +23,4 @@ std::string writePly(const render::tessellate::TriangleMesh& mesh,
 std::string writeObjMesh(const render::tessellate::TriangleMesh& mesh,
                          const std::vector<std::string>& comments);
 
-}  // namespace limn::api
+}  // namespace limn::formats
