@@ -1,5 +1,6 @@
 #include "formats/assimp_import.h"
 
+#include <assimp/BaseImporter.h>
 #include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 
@@ -50,6 +52,34 @@ class NoFiles : public Assimp::IOSystem {
 [[noreturn]] void unreadable(ImportFormat format, const std::string& why) {
   throw InputError(InputError::Kind::InvalidMesh, "mesh.data",
                    std::string("the ") + importFormatName(format) + " file cannot be read: " + why);
+}
+
+// Whether Assimp's importer `desc` reads files named *.extension.
+bool readsExtension(const aiImporterDesc* desc, std::string_view extension) {
+  if (!desc || !desc->mFileExtensions) return false;
+  std::string_view list = desc->mFileExtensions;
+  while (!list.empty()) {
+    const size_t space = list.find(' ');
+    if (list.substr(0, space) == extension) return true;
+    if (space == std::string_view::npos) break;
+    list.remove_prefix(space + 1);
+  }
+  return false;
+}
+
+// Assimp's importers of other formats, taken out of `importer` (and deleted with the returned
+// list, after it): when the named format's importer declines a file, Assimp otherwise guesses
+// the format from the content among all of its some 40 importers, so a file sent as "gltf"
+// could reach the Quake 3 or the Blender reader (fuzz/mesh_import found exactly that).
+std::vector<std::unique_ptr<Assimp::BaseImporter>> keepOnlyImportersOf(Assimp::Importer& importer,
+                                                                       ImportFormat format) {
+  std::vector<std::unique_ptr<Assimp::BaseImporter>> others;
+  for (size_t i = importer.GetImporterCount(); i-- > 0;) {
+    if (readsExtension(importer.GetImporterInfo(i), importFormatName(format))) continue;
+    Assimp::BaseImporter* other = importer.GetImporter(i);
+    if (importer.UnregisterLoader(other) == aiReturn_SUCCESS) others.emplace_back(other);
+  }
+  return others;
 }
 
 const aiScene* readScene(Assimp::Importer& importer, std::string_view bytes, ImportFormat format) {
@@ -281,6 +311,7 @@ ImportedMesh importMesh(std::string_view bytes, ImportFormat format, const Impor
   checkDeclaredSizes(bytes, format, limits);
 
   Assimp::Importer importer;
+  const auto others = keepOnlyImportersOf(importer, format);
   const aiScene* scene = readScene(importer, bytes, format);
   const std::vector<Instance> instances = instancesOf(*scene, options.meshName);
   if (instances.empty()) {

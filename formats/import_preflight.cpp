@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/core/error.h"
@@ -66,52 +67,100 @@ std::optional<uint64_t> number(std::string_view text) {
   return value;
 }
 
+// The scalar types of PLY (both spellings) and their sizes; 0: not a PLY type.
 size_t plyScalarBytes(std::string_view type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "double" || type == "float64") return 8;
-  return 4;  // int, uint, float and their sized names
+  static const std::pair<std::string_view, size_t> kTypes[] = {
+      {"char", 1},   {"uchar", 1},  {"int8", 1},    {"uint8", 1},   {"short", 2},  {"ushort", 2},
+      {"int16", 2},  {"uint16", 2}, {"int", 4},     {"uint", 4},    {"int32", 4},  {"uint32", 4},
+      {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8},
+  };
+  for (const auto& [name, size] : kTypes) {
+    if (type == name) return size;
+  }
+  return 0;
 }
 
-// PLY: each element needs at least its properties' bytes (binary; a list at least its count)
-// or two characters per property (ASCII: a digit and a separator).
-void checkPly(std::string_view bytes, const MeshLimits& limits) {
-  // Assimp 5.2's PLY reader loops forever on a header that never ends.
-  const size_t end = bytes.find("end_header");
-  if (bytes.substr(0, 3) != "ply" || end == std::string_view::npos) {
-    throw InputError(InputError::Kind::InvalidMesh, "mesh.data",
-                     "the ply file has no PLY header (\"ply\" ... \"end_header\")");
+[[noreturn]] void badPlyHeader(int line, const std::string& why) {
+  throw InputError(InputError::Kind::InvalidMesh, "mesh.data",
+                   "the ply file's header line " + std::to_string(line) + " " + why);
+}
+
+bool printable(std::string_view line) {
+  for (unsigned char c : line) {
+    if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7F) return false;
   }
-  const size_t bodyStart = bytes.find('\n', end);
-  const size_t body = bodyStart == std::string_view::npos ? 0 : bytes.size() - bodyStart - 1;
-  bool ascii = false;
+  return true;
+}
+
+// PLY: the header is checked line by line against the grammar (Assimp 5.2's PLY reader loops
+// forever on a header that never ends and reads out of bounds on some malformed property
+// lines: both found by fuzz/mesh_import), then each element needs at least its properties'
+// bytes (binary; a list at least its count) or two characters per property (ASCII: a digit and
+// a separator).
+void checkPly(std::string_view bytes, const MeshLimits& limits) {
+  bool ascii = false, formatSeen = false, ended = false, inElement = false;
   uint64_t need = 0, vertices = 0, faces = 0, elementCount = 0, elementBytes = 0;
   std::string_view elementName;
   auto closeElement = [&] {
+    if (!inElement) return;
     need = plus(need, times(elementCount, std::max<uint64_t>(elementBytes, 1)));
     if (elementName == "vertex") vertices = elementCount;
     if (elementName == "face") faces = elementCount;
     elementCount = elementBytes = 0;
   };
   size_t at = 0;
-  while (at < end) {
+  int line = 0;
+  while (at < bytes.size() && !ended) {
     size_t next = bytes.find('\n', at);
-    if (next == std::string_view::npos || next > end) next = end;
-    const std::vector<std::string_view> w = words(bytes.substr(at, next - at));
+    if (next == std::string_view::npos) next = bytes.size();
+    const std::string_view text = bytes.substr(at, next - at);
     at = next + 1;
-    if (w.size() >= 2 && w[0] == "format") ascii = w[1] == "ascii";
-    if (w.size() >= 3 && w[0] == "element") {
+    ++line;
+    if (!printable(text)) badPlyHeader(line, "holds control characters");
+    const std::vector<std::string_view> w = words(text);
+    if (line == 1) {
+      if (w.size() != 1 || w[0] != "ply") badPlyHeader(line, "is not \"ply\"");
+      continue;
+    }
+    if (w.empty()) badPlyHeader(line, "is empty");
+    if (w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "end_header" && w.size() == 1) {
+      ended = true;
+    } else if (w[0] == "format") {
+      if (formatSeen || inElement || w.size() != 3 || w[2] != "1.0" ||
+          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian")) {
+        badPlyHeader(line, "is not one format line before the elements (format ascii 1.0, ...)");
+      }
+      formatSeen = true;
+      ascii = w[1] == "ascii";
+    } else if (w[0] == "element") {
+      const std::optional<uint64_t> count = w.size() == 3 ? number(w[2]) : std::nullopt;
+      if (!count) badPlyHeader(line, "is not \"element NAME COUNT\"");
       closeElement();
+      inElement = true;
       elementName = w[1];
-      elementCount = number(w[2]).value_or(0);
-    }
-    if (w.size() >= 3 && w[0] == "property") {
-      const bool list = w[1] == "list";
+      elementCount = *count;
+    } else if (w[0] == "property") {
+      const bool list = w.size() == 5 && w[1] == "list";
+      const bool typed = list ? plyScalarBytes(w[2]) > 0 && plyScalarBytes(w[3]) > 0
+                              : w.size() == 3 && plyScalarBytes(w[1]) > 0;
+      if (!inElement || !typed) {
+        badPlyHeader(line, "is not \"property TYPE NAME\" or \"property list TYPE TYPE NAME\" "
+                           "of an element");
+      }
       elementBytes += ascii ? 2 : plyScalarBytes(list ? w[2] : w[1]);
+    } else {
+      badPlyHeader(line, "is not a PLY header line");
     }
+  }
+  if (!ended || !formatSeen) {
+    throw InputError(InputError::Kind::InvalidMesh, "mesh.data",
+                     "the ply file has no complete PLY header (\"ply\", \"format ...\", "
+                     "elements, \"end_header\")");
   }
   closeElement();
   checkMeshCounts(vertices, faces, limits);
+  const uint64_t body = bytes.size() - std::min(at, bytes.size());
   if (need > body) {
     dishonest(ImportFormat::Ply,
               std::to_string(vertices) + " vertices and " + std::to_string(faces) + " faces", need,
@@ -119,29 +168,36 @@ void checkPly(std::string_view bytes, const MeshLimits& limits) {
   }
 }
 
-// OFF: "OFF [nv nf ne]" then the counts; a vertex line is at least "0 0 0\n", a face line at
-// least "3 0 1 2\n". Comment lines (#) are skipped.
+// OFF: a header line ("OFF", or a variant such as "COFF", "NOFF") alone, then the line of counts
+// "nv nf [ne]" in decimal — nothing else, since Assimp reads the counts with a lenient prefix
+// parse (fuzz/mesh_import found "OFF 6" then "802384185579,0.6" allocating 46 GB). A vertex
+// line is at least "0 0 0\n", a face line at least "3 0 1 2\n". Comment lines (#) are skipped.
 void checkOff(std::string_view bytes, const MeshLimits& limits) {
-  std::vector<std::string_view> tokens;
+  std::vector<std::vector<std::string_view>> lines;  // the first two that are not comments
   size_t at = 0;
-  while (at < bytes.size() && tokens.size() < 3) {
+  while (at < bytes.size() && lines.size() < 2) {
     size_t next = bytes.find('\n', at);
     if (next == std::string_view::npos) next = bytes.size();
     std::string_view line = bytes.substr(at, next - at);
     at = next + 1;
     if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    for (std::string_view word : words(line)) {
-      if (tokens.empty() && word.size() >= 3 && word.substr(word.size() - 3) == "OFF") {
-        tokens.push_back(word);
-      } else if (!tokens.empty()) {
-        tokens.push_back(word);
-      }
-      if (tokens.size() == 3) break;
-    }
+    std::vector<std::string_view> w = words(line);
+    if (!w.empty()) lines.push_back(std::move(w));
   }
-  if (tokens.size() < 3) return;
-  const std::optional<uint64_t> vertices = number(tokens[1]), faces = number(tokens[2]);
-  if (!vertices || !faces) return;
+  const bool header = lines.size() == 2 && lines[0].size() == 1 && lines[0][0].size() >= 3 &&
+                      lines[0][0].substr(lines[0][0].size() - 3) == "OFF";
+  const std::vector<std::string_view>& counts = lines.size() == 2 ? lines[1] : lines.emplace_back();
+  std::optional<uint64_t> vertices, faces;
+  if (counts.size() == 2 || counts.size() == 3) {
+    vertices = number(counts[0]);
+    faces = number(counts[1]);
+    if (counts.size() == 3 && !number(counts[2])) faces.reset();
+  }
+  if (!header || !vertices || !faces) {
+    throw InputError(InputError::Kind::InvalidMesh, "mesh.data",
+                     "the off file does not start with an OFF line and then the line of counts "
+                     "\"vertices faces [edges]\"");
+  }
   checkMeshCounts(*vertices, *faces, limits);
   const uint64_t need = plus(times(*vertices, 6), times(*faces, 8));
   if (need > bytes.size()) {
@@ -198,9 +254,19 @@ uint64_t gltfElementBytes(const rapidjson::Value& accessor) {
 void checkGltf(std::string_view bytes, ImportFormat format) {
   std::string_view json = bytes;
   if (format == ImportFormat::Glb) {
-    if (bytes.size() < 20 || bytes.substr(0, 4) != "glTF") return;
-    const uint64_t length = littleEndian32(bytes.data() + 12);
-    json = bytes.substr(20, std::min<uint64_t>(length, bytes.size() - 20));
+    if (bytes.size() < 20 || bytes.substr(0, 4) != "glTF") return;  // Assimp will say
+    // The header's total and each chunk's length (Assimp allocates what they say).
+    const uint64_t total = littleEndian32(bytes.data() + 8);
+    if (total > bytes.size()) dishonest(format, "a GLB of " + std::to_string(total) + " bytes", total, bytes.size());
+    for (uint64_t at = 12; at + 8 <= bytes.size();) {
+      const uint64_t chunk = littleEndian32(bytes.data() + at);
+      if (at + 8 + chunk > bytes.size()) {
+        dishonest(format, "a chunk of " + std::to_string(chunk) + " bytes", at + 8 + chunk,
+                  bytes.size());
+      }
+      at += 8 + chunk;
+    }
+    json = bytes.substr(20, littleEndian32(bytes.data() + 12));
   }
   rapidjson::Document document;
   document.Parse<rapidjson::kParseIterativeFlag>(json.data(), json.size());

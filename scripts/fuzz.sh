@@ -15,13 +15,15 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift $(( $# > 0 ? 1 : 0 ))
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(obj_reader json_mesh render_request silhouette_request implicit_request config engine)
+[ ${#targets[@]} -eq 0 ] && targets=(obj_reader json_mesh render_request silhouette_request implicit_request config engine
+  mesh_import)
 for target in "${targets[@]}"; do
   [ -x "build-sanitize/bin/${target}_fuzz" ] || { scripts/sanitize.sh -N >/dev/null; break; }
 done
 mkdir -p build-sanitize/fuzz-findings build-sanitize/fuzz-logs
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp"
 
 run_target() {
   local target=$1
@@ -38,6 +40,8 @@ run_target() {
     # loaded, so no leak detection: see scripts/sanitize.sh) within a 20 s deadline of its own
     # (fuzz/engine_fuzz.cpp), hence more time and memory; past 120 s a stage ignored it.
     engine) options=(-max_len="${LIMN_FUZZ_MAX_LEN:-4096}" -rss_limit_mb=4096 -timeout=120) ;;
+    # mesh_import: binary and text formats alike (the first byte picks one); no dictionary.
+    mesh_import) ;;
     *) options+=(-dict=fuzz/json.dict) ;;
   esac
   local asan="$ASAN_OPTIONS"

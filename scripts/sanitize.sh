@@ -13,7 +13,7 @@ modules="render/core;render/mesh;render/subdiv;render/normalmap;render/rules;ren
 modules+=";render/patches"
 modules+=";render/implicit"
 modules+=";render/silhouette;render/image;render/raster;render/metrics;render/oracle"
-modules+=";render/pipeline;api;batch;tests/support;server;tests/integration;fuzz"
+modules+=";render/pipeline;formats;api;batch;tests/support;server;tests/integration;fuzz"
 # -O1 with line tables only: about half the compile time of RelWithDebInfo, and still every
 # frame of a sanitizer report named with its file and line.
 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Sanitize \
