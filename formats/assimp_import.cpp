@@ -1,14 +1,14 @@
 #include "formats/assimp_import.h"
 
 #include <assimp/BaseImporter.h>
-#include <assimp/IOSystem.hpp>
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
 #include <array>
+#include <assimp/IOSystem.hpp>
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -24,8 +24,8 @@ namespace limn::formats {
 namespace {
 
 using render::InputError;
-using render::mesh::ControlMesh;
 using render::Vec3;
+using render::mesh::ControlMesh;
 using render::mesh::MeshLimits;
 
 struct NamedFormat {
@@ -34,8 +34,8 @@ struct NamedFormat {
 };
 
 constexpr NamedFormat kFormatNames[] = {
-    {"gltf", ImportFormat::Gltf}, {"glb", ImportFormat::Glb},     {"ply", ImportFormat::Ply},
-    {"stl", ImportFormat::Stl},   {"fbx", ImportFormat::Fbx},     {"dae", ImportFormat::Dae},
+    {"gltf", ImportFormat::Gltf},   {"glb", ImportFormat::Glb}, {"ply", ImportFormat::Ply},
+    {"stl", ImportFormat::Stl},     {"fbx", ImportFormat::Fbx}, {"dae", ImportFormat::Dae},
     {"3ds", ImportFormat::ThreeDs}, {"off", ImportFormat::Off},
 };
 
@@ -130,7 +130,8 @@ std::vector<Instance> instancesOf(const aiScene& scene, const std::string& meshN
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
       const unsigned m = node->mMeshes[i];
       if (m >= scene.mNumMeshes) continue;
-      if (meshName.empty() || named(node->mName, meshName) || named(scene.mMeshes[m]->mName, meshName)) {
+      if (meshName.empty() || named(node->mName, meshName) ||
+          named(scene.mMeshes[m]->mName, meshName)) {
         instance.meshes.push_back(m);
       }
     }
@@ -144,7 +145,8 @@ std::string meshNamesOf(const aiScene& scene) {
   std::string names;
   for (unsigned m = 0; m < scene.mNumMeshes && m < 12; ++m) {
     if (!names.empty()) names += ", ";
-    names += "\"" + std::string(scene.mMeshes[m]->mName.data, scene.mMeshes[m]->mName.length) + "\"";
+    names +=
+        "\"" + std::string(scene.mMeshes[m]->mName.data, scene.mMeshes[m]->mName.length) + "\"";
   }
   return names.empty() ? "none" : names;
 }
@@ -178,7 +180,8 @@ void checkSceneSize(const aiScene& scene, const std::vector<Instance>& instances
 using PositionKey = std::array<uint64_t, 3>;
 struct PositionHash {
   size_t operator()(const PositionKey& k) const {
-    return std::hash<uint64_t>()(k[0] * 0x9E3779B97F4A7C15ull ^ k[1] * 0xC2B2AE3D27D4EB4Full ^ k[2]);
+    return std::hash<uint64_t>()(k[0] * 0x9E3779B97F4A7C15ull ^ k[1] * 0xC2B2AE3D27D4EB4Full ^
+                                 k[2]);
   }
 };
 
@@ -190,8 +193,8 @@ PositionKey keyOf(const Vec3& p) {
 }
 
 struct Counts {
-  int pointsAndLines = 0;   // primitives of fewer than 3 corners, left out
-  int collapsedFaces = 0;   // faces under 3 distinct corners once welded, left out
+  int pointsAndLines = 0;  // primitives of fewer than 3 corners, left out
+  int collapsedFaces = 0;  // faces under 3 distinct corners once welded, left out
 };
 
 // Appends one node's meshes to `out`, welded by position among themselves.
@@ -237,7 +240,8 @@ void appendInstance(const aiScene& scene, const Instance& instance, ImportFormat
       }
       corners.clear();
       for (unsigned c = 0; c < face.mNumIndices; ++c) {
-        if (face.mIndices[c] >= source.mNumVertices) unreadable(format, "a face index is out of range");
+        if (face.mIndices[c] >= source.mNumVertices)
+          unreadable(format, "a face index is out of range");
         const int v = index[face.mIndices[c]];
         if (corners.empty() || corners.back() != v) corners.push_back(v);
       }
@@ -292,11 +296,16 @@ const std::vector<std::string>& importFormatNames() {
 
 std::optional<ImportFormat> importFormatOfMediaType(std::string_view mediaType) {
   static const std::pair<const char*, ImportFormat> kTypes[] = {
-      {"model/gltf-binary", ImportFormat::Glb},   {"model/gltf+json", ImportFormat::Gltf},
-      {"model/stl", ImportFormat::Stl},           {"application/sla", ImportFormat::Stl},
-      {"model/ply", ImportFormat::Ply},           {"application/x-ply", ImportFormat::Ply},
-      {"model/vnd.collada+xml", ImportFormat::Dae}, {"application/x-3ds", ImportFormat::ThreeDs},
-      {"image/x-3ds", ImportFormat::ThreeDs},     {"application/x-fbx", ImportFormat::Fbx},
+      {"model/gltf-binary", ImportFormat::Glb},
+      {"model/gltf+json", ImportFormat::Gltf},
+      {"model/stl", ImportFormat::Stl},
+      {"application/sla", ImportFormat::Stl},
+      {"model/ply", ImportFormat::Ply},
+      {"application/x-ply", ImportFormat::Ply},
+      {"model/vnd.collada+xml", ImportFormat::Dae},
+      {"application/x-3ds", ImportFormat::ThreeDs},
+      {"image/x-3ds", ImportFormat::ThreeDs},
+      {"application/x-fbx", ImportFormat::Fbx},
       {"model/x-off", ImportFormat::Off},
   };
   for (const auto& [type, format] : kTypes) {
@@ -317,8 +326,9 @@ ImportedMesh importMesh(std::string_view bytes, ImportFormat format, const Impor
   if (instances.empty()) {
     if (!options.meshName.empty()) {
       throw InputError(InputError::Kind::InvalidMesh, "mesh.name",
-                       "the " + std::string(importFormatName(format)) + " file has no mesh named \"" +
-                           options.meshName + "\"; its meshes: " + meshNamesOf(*scene));
+                       "the " + std::string(importFormatName(format)) +
+                           " file has no mesh named \"" + options.meshName +
+                           "\"; its meshes: " + meshNamesOf(*scene));
     }
     unreadable(format, "it holds no mesh");
   }
@@ -329,7 +339,8 @@ ImportedMesh importMesh(std::string_view bytes, ImportFormat format, const Impor
   for (const Instance& instance : instances) {
     appendInstance(*scene, instance, format, limits, out, counts);
   }
-  if (out.mesh.faceCount() == 0) unreadable(format, "its meshes have no faces of 3 or more corners");
+  if (out.mesh.faceCount() == 0)
+    unreadable(format, "its meshes have no faces of 3 or more corners");
   chooseScheme(options, out);
   if (counts.pointsAndLines > 0) {
     out.warnings.push_back(std::to_string(counts.pointsAndLines) +

@@ -46,9 +46,9 @@ struct ImportOptions {
 
 struct ImportedMesh {
   render::mesh::ControlMesh mesh;
-  bool schemeChosen = false;   // the scheme came from the faces, not from the caller
-  int meshesMerged = 0;        // mesh instances (node, mesh) in the result
-  int verticesWelded = 0;      // file vertices that became one with another
+  bool schemeChosen = false;  // the scheme came from the faces, not from the caller
+  int meshesMerged = 0;       // mesh instances (node, mesh) in the result
+  int verticesWelded = 0;     // file vertices that became one with another
   std::vector<std::string> warnings;
 };
 

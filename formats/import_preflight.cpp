@@ -42,8 +42,8 @@ void checkMeshCounts(uint64_t vertices, uint64_t faces, const MeshLimits& limits
   }
   if (vertices > 8 * static_cast<uint64_t>(limits.maxVertices)) {
     throw InputError(InputError::Kind::LimitExceeded, "maxVertices",
-                     "the file declares " + std::to_string(vertices) +
-                         " vertices, more than 8 x " + std::to_string(limits.maxVertices));
+                     "the file declares " + std::to_string(vertices) + " vertices, more than 8 x " +
+                         std::to_string(limits.maxVertices));
   }
 }
 
@@ -70,9 +70,9 @@ std::optional<uint64_t> number(std::string_view text) {
 // The scalar types of PLY (both spellings) and their sizes; 0: not a PLY type.
 size_t plyScalarBytes(std::string_view type) {
   static const std::pair<std::string_view, size_t> kTypes[] = {
-      {"char", 1},   {"uchar", 1},  {"int8", 1},    {"uint8", 1},   {"short", 2},  {"ushort", 2},
-      {"int16", 2},  {"uint16", 2}, {"int", 4},     {"uint", 4},    {"int32", 4},  {"uint32", 4},
-      {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8},
+      {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},   {"short", 2}, {"ushort", 2},
+      {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},    {"int32", 4}, {"uint32", 4},
+      {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8},
   };
   for (const auto& [name, size] : kTypes) {
     if (type == name) return size;
@@ -145,8 +145,9 @@ void checkPly(std::string_view bytes, const MeshLimits& limits) {
       const bool typed = list ? plyScalarBytes(w[2]) > 0 && plyScalarBytes(w[3]) > 0
                               : w.size() == 3 && plyScalarBytes(w[1]) > 0;
       if (!inElement || !typed) {
-        badPlyHeader(line, "is not \"property TYPE NAME\" or \"property list TYPE TYPE NAME\" "
-                           "of an element");
+        badPlyHeader(line,
+                     "is not \"property TYPE NAME\" or \"property list TYPE TYPE NAME\" "
+                     "of an element");
       }
       elementBytes += ascii ? 2 : plyScalarBytes(list ? w[2] : w[1]);
     } else {
@@ -180,7 +181,8 @@ void checkOff(std::string_view bytes, const MeshLimits& limits) {
     if (next == std::string_view::npos) next = bytes.size();
     std::string_view line = bytes.substr(at, next - at);
     at = next + 1;
-    if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    if (const size_t hash = line.find('#'); hash != std::string_view::npos)
+      line = line.substr(0, hash);
     std::vector<std::string_view> w = words(line);
     if (!w.empty()) lines.push_back(std::move(w));
   }
@@ -243,8 +245,12 @@ uint64_t gltfElementBytes(const rapidjson::Value& accessor) {
   uint64_t count = 1;
   if (accessor.HasMember("type") && accessor["type"].IsString()) {
     const std::string_view type = accessor["type"].GetString();
-    count = type == "VEC2" ? 2 : type == "VEC3" ? 3 : type == "VEC4" || type == "MAT2" ? 4
-            : type == "MAT3" ? 9 : type == "MAT4" ? 16 : 1;
+    count = type == "VEC2"                     ? 2
+            : type == "VEC3"                   ? 3
+            : type == "VEC4" || type == "MAT2" ? 4
+            : type == "MAT3"                   ? 9
+            : type == "MAT4"                   ? 16
+                                               : 1;
   }
   return component * count;
 }
@@ -257,7 +263,8 @@ void checkGltf(std::string_view bytes, ImportFormat format) {
     if (bytes.size() < 20 || bytes.substr(0, 4) != "glTF") return;  // Assimp will say
     // The header's total and each chunk's length (Assimp allocates what they say).
     const uint64_t total = littleEndian32(bytes.data() + 8);
-    if (total > bytes.size()) dishonest(format, "a GLB of " + std::to_string(total) + " bytes", total, bytes.size());
+    if (total > bytes.size())
+      dishonest(format, "a GLB of " + std::to_string(total) + " bytes", total, bytes.size());
     for (uint64_t at = 12; at + 8 <= bytes.size();) {
       const uint64_t chunk = littleEndian32(bytes.data() + at);
       if (at + 8 + chunk > bytes.size()) {
@@ -281,8 +288,9 @@ void checkGltf(std::string_view bytes, ImportFormat format) {
   each("buffers", [&](const rapidjson::Value& buffer, rapidjson::SizeType i) {
     if (buffer.HasMember("byteLength") && buffer["byteLength"].IsUint64() &&
         buffer["byteLength"].GetUint64() > bytes.size()) {
-      dishonest(format, "buffer " + std::to_string(i) + " of " +
-                            std::to_string(buffer["byteLength"].GetUint64()) + " bytes",
+      dishonest(format,
+                "buffer " + std::to_string(i) + " of " +
+                    std::to_string(buffer["byteLength"].GetUint64()) + " bytes",
                 buffer["byteLength"].GetUint64(), bytes.size());
     }
   });
@@ -291,7 +299,8 @@ void checkGltf(std::string_view bytes, ImportFormat format) {
     const uint64_t count = accessor["count"].GetUint64();
     const uint64_t need = times(count, gltfElementBytes(accessor));
     if (need > bytes.size()) {
-      dishonest(format, "accessor " + std::to_string(i) + " of " + std::to_string(count) + " elements",
+      dishonest(format,
+                "accessor " + std::to_string(i) + " of " + std::to_string(count) + " elements",
                 need, bytes.size());
     }
   });
@@ -317,14 +326,25 @@ void checkCollada(std::string_view bytes) {
 
 void checkDeclaredSizes(std::string_view bytes, ImportFormat format, const MeshLimits& limits) {
   switch (format) {
-    case ImportFormat::Ply: checkPly(bytes, limits); break;
-    case ImportFormat::Off: checkOff(bytes, limits); break;
-    case ImportFormat::Stl: checkStl(bytes, limits); break;
+    case ImportFormat::Ply:
+      checkPly(bytes, limits);
+      break;
+    case ImportFormat::Off:
+      checkOff(bytes, limits);
+      break;
+    case ImportFormat::Stl:
+      checkStl(bytes, limits);
+      break;
     case ImportFormat::Gltf:
-    case ImportFormat::Glb: checkGltf(bytes, format); break;
-    case ImportFormat::Dae: checkCollada(bytes); break;
+    case ImportFormat::Glb:
+      checkGltf(bytes, format);
+      break;
+    case ImportFormat::Dae:
+      checkCollada(bytes);
+      break;
     case ImportFormat::Fbx:
-    case ImportFormat::ThreeDs: break;
+    case ImportFormat::ThreeDs:
+      break;
   }
 }
 

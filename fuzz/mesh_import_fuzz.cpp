@@ -10,11 +10,10 @@
 // a file costs only its own request. So a child that dies of a signal, runs out of time or
 // memory is contained, as in the server; a child that leaves with an exception limn does not
 // document is a finding (the parent aborts, and libFuzzer keeps the input).
+#include <sanitizer/common_interface_defs.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <sanitizer/common_interface_defs.h>
 
 #include <chrono>
 #include <csignal>
@@ -35,7 +34,7 @@ using limn::formats::ImportFormat;
 constexpr int kUndocumentedError = 42;
 constexpr int kOverCeiling = 43;
 constexpr int kRefused = 44;
-constexpr long kCeilingBytes = 2L << 30;  // 2 GiB, as the fuzz runs' -rss_limit_mb
+constexpr long kCeilingBytes = 2L << 30;             // 2 GiB, as the fuzz runs' -rss_limit_mb
 constexpr auto kDeadline = std::chrono::seconds(5);  // within the run's -timeout=10
 
 long residentBytes() {
@@ -52,7 +51,8 @@ void watchChild() {
   for (int signal : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) std::signal(signal, SIG_DFL);
   std::thread([] {
     const auto start = std::chrono::steady_clock::now();
-    while (residentBytes() < kCeilingBytes && std::chrono::steady_clock::now() - start < kDeadline) {
+    while (residentBytes() < kCeilingBytes &&
+           std::chrono::steady_clock::now() - start < kDeadline) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     std::_Exit(kOverCeiling);
@@ -90,8 +90,8 @@ struct Outcomes {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
-  const ImportFormat formats[] = {ImportFormat::Gltf, ImportFormat::Glb, ImportFormat::Ply,
-                                  ImportFormat::Stl,  ImportFormat::Fbx, ImportFormat::Dae,
+  const ImportFormat formats[] = {ImportFormat::Gltf,    ImportFormat::Glb, ImportFormat::Ply,
+                                  ImportFormat::Stl,     ImportFormat::Fbx, ImportFormat::Dae,
                                   ImportFormat::ThreeDs, ImportFormat::Off};
   const ImportFormat format = formats[data[0] % 8];
   const std::string_view file = limn::fuzz::asText(data + 1, size - 1);

@@ -68,8 +68,8 @@ std::string maskRequest(const std::string& meshJson) {
 
 std::string fileMesh(const std::string& format, const std::string& file,
                      const std::string& more = "") {
-  return R"({"format":")" + format + R"(","dataBase64":")" + api::encodeBase64(file) + "\"" +
-         more + "}";
+  return R"({"format":")" + format + R"(","dataBase64":")" + api::encodeBase64(file) + "\"" + more +
+         "}";
 }
 
 render::Image maskOf(const rapidjson::Document& answer) {
@@ -94,11 +94,12 @@ void expectSameOutline(const render::Image& expected, const render::Image& got,
   ASSERT_EQ(got.width, expected.width);
   int differing = 0;
   for (int y = 0; y < got.height; ++y)
-    for (int x = 0; x < got.width; ++x) differing += (got.at(x, y) < 0.5f) != (expected.at(x, y) < 0.5f);
+    for (int x = 0; x < got.width; ++x)
+      differing += (got.at(x, y) < 0.5f) != (expected.at(x, y) < 0.5f);
   const int outline = outlinePixels(expected);
   EXPECT_GT(outline, 100) << what;  // the surface is in the picture
-  EXPECT_LE(differing, outline / 4) << what << ": " << differing << " pixels differ along an outline of "
-                                    << outline;
+  EXPECT_LE(differing, outline / 4)
+      << what << ": " << differing << " pixels differ along an outline of " << outline;
 }
 
 struct FileCase {
@@ -109,9 +110,9 @@ struct FileCase {
 };
 
 const FileCase kFiles[] = {
-    {"glb2", "glb", false},   {"gltf2", "gltf", false},    {"ply", "ply", true},
-    {"plyb", "ply", true},    {"stl", "stl", false},       {"stlb", "stl", false},
-    {"fbxa", "fbx", true},    {"collada", "dae", true},    {"3ds", "3ds", false, true},
+    {"glb2", "glb", false}, {"gltf2", "gltf", false}, {"ply", "ply", true},
+    {"plyb", "ply", true},  {"stl", "stl", false},    {"stlb", "stl", false},
+    {"fbxa", "fbx", true},  {"collada", "dae", true}, {"3ds", "3ds", false, true},
 };
 
 ControlMesh zUp(ControlMesh mesh) {
@@ -129,18 +130,22 @@ TEST_F(MeshFilesServer, EveryFormatRendersLikeTheObjItCameFrom) {
     const ControlMesh asRead = c.zUp ? zUp(cage) : cage;
     auto fromObj = answer("/v1/render", maskRequest(R"({"format":"obj","scheme":")" + scheme +
                                                     R"(","data":")" + objText(asRead) + "\"}"));
-    auto fromFile = answer("/v1/render",
-                           maskRequest(fileMesh(c.format, exportWithAssimp({{"cage", cage}}, c.assimpId))));
+    auto fromFile =
+        answer("/v1/render",
+               maskRequest(fileMesh(c.format, exportWithAssimp({{"cage", cage}}, c.assimpId))));
     expectSameOutline(maskOf(*fromObj), maskOf(*fromFile), c.assimpId);
     // The answer says how the file was read, and which scheme the faces chose.
     std::string warnings;
-    for (const auto& w : (*fromFile)["warnings"].GetArray()) warnings += std::string(w.GetString()) + "\n";
-    EXPECT_NE(warnings.find(std::string("mesh read from ") + c.format), std::string::npos) << warnings;
+    for (const auto& w : (*fromFile)["warnings"].GetArray())
+      warnings += std::string(w.GetString()) + "\n";
+    EXPECT_NE(warnings.find(std::string("mesh read from ") + c.format), std::string::npos)
+        << warnings;
     EXPECT_NE(warnings.find("scheme " + scheme), std::string::npos) << warnings;
   }
   // OFF, written by hand (Assimp has no OFF exporter).
   const ControlMesh cage = quadCage();
-  auto fromObj = answer("/v1/render", maskRequest(R"({"format":"obj","data":")" + objText(cage) + "\"}"));
+  auto fromObj =
+      answer("/v1/render", maskRequest(R"({"format":"obj","data":")" + objText(cage) + "\"}"));
   std::string off = writeOff(cage);
   auto fromOff = answer("/v1/render", maskRequest(fileMesh("off", off)));
   expectSameOutline(maskOf(*fromObj), maskOf(*fromOff), "off");
@@ -169,8 +174,8 @@ TEST_F(MeshFilesServer, AFileUploadedAsItselfIsTheMeshItHolds) {
   const ControlMesh quads = quadCage();
   auto ply = answer("/v1/meshes", exportWithAssimp({{"q", quads}}, "plyb"), 200,
                     {{"Content-Type", "model/ply"}});
-  auto off = answer("/v1/meshes?format=off", writeOff(quads), 200,
-                    {{"Content-Type", "text/plain"}});
+  auto off =
+      answer("/v1/meshes?format=off", writeOff(quads), 200, {{"Content-Type", "text/plain"}});
   EXPECT_EQ((*ply)["faces"].GetInt(), quads.faceCount());
   EXPECT_EQ((*off)["faces"].GetInt(), quads.faceCount());
 
@@ -180,8 +185,8 @@ TEST_F(MeshFilesServer, AFileUploadedAsItselfIsTheMeshItHolds) {
 
 TEST_F(MeshFilesServer, TwoMeshesInOneFileAreMergedOrPickedByName) {
   const ControlMesh ico = triangleCage();
-  const std::string glb = exportWithAssimp({{"left", ico, {-1.8, 0, 0}}, {"right", ico, {1.8, 0, 0}}},
-                                           "glb2");
+  const std::string glb =
+      exportWithAssimp({{"left", ico, {-1.8, 0, 0}}, {"right", ico, {1.8, 0, 0}}}, "glb2");
   auto merged = answer("/v1/meshes", glb, 200, {{"Content-Type", "model/gltf-binary"}});
   EXPECT_EQ((*merged)["faces"].GetInt(), 2 * ico.faceCount());
   auto right = answer("/v1/meshes?name=right", glb, 200, {{"Content-Type", "model/gltf-binary"}});
@@ -194,15 +199,17 @@ TEST_F(MeshFilesServer, TwoMeshesInOneFileAreMergedOrPickedByName) {
 TEST_F(MeshFilesServer, BadFilesAre422NamingTheFormatAndTheServerKeepsServing) {
   const std::string cut = exportWithAssimp({{"ico", triangleCage()}}, "glb2").substr(0, 200);
   for (const char* format : {"glb", "gltf", "ply", "stl", "fbx", "dae", "3ds", "off"}) {
-    auto bad = answer("/v1/render", maskRequest(fileMesh(format, "not a " + std::string(format) +
-                                                                     " file \x01\x02")), 422);
+    auto bad = answer(
+        "/v1/render",
+        maskRequest(fileMesh(format, "not a " + std::string(format) + " file \x01\x02")), 422);
     const std::string message = (*bad)["error"]["message"].GetString();
     EXPECT_NE(message.find(std::string("the ") + format + " file"), std::string::npos) << message;
   }
   answer("/v1/render", maskRequest(fileMesh("glb", cut)), 422);
   // A few bytes that declare a billion vertices: refused, at once.
-  const std::string bomb = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
-                           "property float x\nproperty float y\nproperty float z\nend_header\n";
+  const std::string bomb =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
+      "property float x\nproperty float y\nproperty float z\nend_header\n";
   auto limit = answer("/v1/meshes", bomb, 413, {{"Content-Type", "model/ply"}});
   EXPECT_STREQ((*limit)["error"]["code"].GetString(), "too_large");
   answer("/v1/render", maskRequest(fileMesh("gltf", "{}", R"(,"data":"{}")")), 400);

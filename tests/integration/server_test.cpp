@@ -643,6 +643,10 @@ TEST(ServerShutdown, SigtermUnderLoadDrainsAnswersEveryoneAndExitsInBoundedTime)
       R"({"workers": 1, "queueDepth": 16, "heavyQueueMs": 86400000, "shutdownDrainMs": )" +
       std::to_string(drain.count()) + "}");
   const int port = server.port();
+  // Warm this server's worker as the probe's was: a cold worker's first render (its GL context,
+  // llvmpipe's shaders) can take several warm renders' time, and it would be the one running at
+  // the signal.
+  ASSERT_EQ(post(port, "/v1/render", slowRender()).status, 200);
   std::vector<int> statuses(kClients, 0);
   std::vector<std::thread> clients;
   for (int i = 0; i < kClients; ++i) {

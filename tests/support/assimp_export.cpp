@@ -1,12 +1,12 @@
 #include "tests/support/assimp_export.h"
 
-#include <assimp/Exporter.hpp>
 #include <assimp/scene.h>
 #include <rapidjson/document.h>
 #include <rapidjson/stringbuffer.h>
 #include <rapidjson/writer.h>
 
 #include <algorithm>
+#include <assimp/Exporter.hpp>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -59,7 +59,7 @@ std::unique_ptr<aiScene> sceneOf(const std::vector<SceneMesh>& meshes) {
   auto scene = std::make_unique<aiScene>();
   scene->mRootNode = new aiNode("root");
   scene->mNumMaterials = 1;
-  scene->mMaterials = new aiMaterial*[1]{new aiMaterial};
+  scene->mMaterials = new aiMaterial* [1] { new aiMaterial };
   scene->mNumMeshes = static_cast<unsigned>(meshes.size());
   scene->mMeshes = new aiMesh*[meshes.size()];
   scene->mRootNode->mNumChildren = static_cast<unsigned>(meshes.size());
@@ -69,9 +69,9 @@ std::unique_ptr<aiScene> sceneOf(const std::vector<SceneMesh>& meshes) {
     auto* node = new aiNode(meshes[i].name);
     node->mParent = scene->mRootNode;
     const render::Vec3& t = meshes[i].translation;
-    aiMatrix4x4::Translation(aiVector3D(static_cast<float>(t.x), static_cast<float>(t.y),
-                                        static_cast<float>(t.z)),
-                             node->mTransformation);
+    aiMatrix4x4::Translation(
+        aiVector3D(static_cast<float>(t.x), static_cast<float>(t.y), static_cast<float>(t.z)),
+        node->mTransformation);
     node->mNumMeshes = 1;
     node->mMeshes = new unsigned[1]{static_cast<unsigned>(i)};
     scene->mRootNode->mChildren[i] = node;
@@ -110,7 +110,8 @@ std::string nonIndexedGltf(const render::mesh::ControlMesh& mesh) {
   float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
   for (int v : mesh.faceVertexIndices) {
     const render::Vec3& p = mesh.points[v];
-    const float xyz[3] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+    const float xyz[3] = {static_cast<float>(p.x), static_cast<float>(p.y),
+                          static_cast<float>(p.z)};
     for (int i = 0; i < 3; ++i) {
       lo[i] = std::min(lo[i], xyz[i]);
       hi[i] = std::max(hi[i], xyz[i]);

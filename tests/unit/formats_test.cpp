@@ -32,7 +32,8 @@ void expectSameCage(const ControlMesh& expected, const ControlMesh& got, const s
   std::vector<int> original(got.points.size(), -1);
   for (size_t v = 0; v < got.points.size(); ++v) {
     for (size_t w = 0; w < expected.points.size(); ++w) {
-      if (length(got.points[v] - expected.points[w]) <= tolerance) original[v] = static_cast<int>(w);
+      if (length(got.points[v] - expected.points[w]) <= tolerance)
+        original[v] = static_cast<int>(w);
     }
     ASSERT_GE(original[v], 0) << what << ": vertex " << v << " is none of the cage's";
   }
@@ -76,8 +77,8 @@ ControlMesh mixedCage() {
 struct FormatCase {
   const char* assimpId;
   ImportFormat format;
-  bool polygons;       // the format keeps faces of more than 3 corners
-  bool zUp = false;    // 3DS: Assimp writes z up and reads the file's axes as they are
+  bool polygons;     // the format keeps faces of more than 3 corners
+  bool zUp = false;  // 3DS: Assimp writes z up and reads the file's axes as they are
 };
 
 // The cage as a z-up file read back holds it: (x, y, z) -> (x, z, -y).
@@ -87,10 +88,14 @@ ControlMesh asReadFromZUp(ControlMesh mesh) {
 }
 
 const FormatCase kFormats[] = {
-    {"glb2", ImportFormat::Glb, false},  {"gltf2", ImportFormat::Gltf, false},
-    {"ply", ImportFormat::Ply, true},    {"plyb", ImportFormat::Ply, true},
-    {"stl", ImportFormat::Stl, false},   {"stlb", ImportFormat::Stl, false},
-    {"fbxa", ImportFormat::Fbx, true},    {"collada", ImportFormat::Dae, true},
+    {"glb2", ImportFormat::Glb, false},
+    {"gltf2", ImportFormat::Gltf, false},
+    {"ply", ImportFormat::Ply, true},
+    {"plyb", ImportFormat::Ply, true},
+    {"stl", ImportFormat::Stl, false},
+    {"stlb", ImportFormat::Stl, false},
+    {"fbxa", ImportFormat::Fbx, true},
+    {"collada", ImportFormat::Dae, true},
     {"3ds", ImportFormat::ThreeDs, false, true},
 };
 
@@ -99,9 +104,9 @@ TEST(AssimpImport, EveryFormatRoundTripsTheCageItWasWrittenFrom) {
     // Formats of triangles only get a triangle cage; the others a cage of quads and pentagons.
     // (Assimp 5.2 cannot read its own binary FBX export, "block offset is out of range", so
     // FBX is written as ASCII: the importer is the same.)
-    const std::vector<ControlMesh> cages =
-        c.polygons ? std::vector<ControlMesh>{quadTorus(), mixedCage()}
-                   : std::vector<ControlMesh>{icosahedron()};
+    const std::vector<ControlMesh> cages = c.polygons
+                                               ? std::vector<ControlMesh>{quadTorus(), mixedCage()}
+                                               : std::vector<ControlMesh>{icosahedron()};
     for (const ControlMesh& cage : cages) {
       const std::string file = exportWithAssimp({{"cage", cage}}, c.assimpId);
       formats::ImportedMesh got = import(file, c.format);
@@ -145,13 +150,13 @@ TEST(AssimpImport, CornersSplitPerFaceAreWeldedIntoOneSurface) {
 TEST(AssimpImport, TwoMeshesAreMergedWithTheirTransformsOrPickedByName) {
   // glTF holds triangles: two icosahedra, three units either side of the origin.
   ControlMesh ico = icosahedron();
-  const std::string two = exportWithAssimp({{"left", ico, {-3, 0, 0}}, {"right", ico, {3, 0.5, 0}}},
-                                           "glb2");
+  const std::string two =
+      exportWithAssimp({{"left", ico, {-3, 0, 0}}, {"right", ico, {3, 0.5, 0}}}, "glb2");
   formats::ImportedMesh merged = import(two, ImportFormat::Glb);
   EXPECT_EQ(merged.meshesMerged, 2);
   EXPECT_EQ(merged.mesh.faceCount(), 2 * ico.faceCount());
   EXPECT_EQ(merged.mesh.vertexCount(), 2 * ico.vertexCount());  // apart: nothing welds across
-  const double t = (1 + std::sqrt(5.0)) / 2;  // the icosahedron's half-width
+  const double t = (1 + std::sqrt(5.0)) / 2;                    // the icosahedron's half-width
   const render::Bounds both = merged.mesh.bounds();
   EXPECT_NEAR(both.lo.x, -3 - t, 1e-5);
   EXPECT_NEAR(both.hi.x, 3 + t, 1e-5);
@@ -177,8 +182,8 @@ TEST(AssimpImport, TwoMeshesAreMergedWithTheirTransformsOrPickedByName) {
 TEST(AssimpImport, TheCallersSchemeWinsOverTheFaces) {
   formats::ImportOptions options;
   options.scheme = Scheme::CatmullClark;
-  formats::ImportedMesh got = import(exportWithAssimp({{"ico", icosahedron()}}, "glb2"),
-                                     ImportFormat::Glb, options);
+  formats::ImportedMesh got =
+      import(exportWithAssimp({{"ico", icosahedron()}}, "glb2"), ImportFormat::Glb, options);
   EXPECT_EQ(got.mesh.scheme, Scheme::CatmullClark);
   EXPECT_FALSE(got.schemeChosen);
 }
@@ -222,9 +227,11 @@ TEST(AssimpImport, FilesDeclaringMoreThanTheyHoldAreRefusedBeforeAllocating) {
   const std::string ply =
       "ply\nformat binary_little_endian 1.0\nelement vertex 1500000000\nproperty float x\n"
       "property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
-      "end_header\n" + std::string(64, '\0');
+      "end_header\n" +
+      std::string(64, '\0');
   EXPECT_NE(expectRefused(ply, ImportFormat::Ply, InputError::Kind::InvalidMesh, generous)
-                .find("1500000000 vertices"), std::string::npos);
+                .find("1500000000 vertices"),
+            std::string::npos);
   EXPECT_NE(expectRefused(ply, ImportFormat::Ply, InputError::Kind::LimitExceeded).find("vertices"),
             std::string::npos);
 
@@ -235,7 +242,8 @@ TEST(AssimpImport, FilesDeclaringMoreThanTheyHoldAreRefusedBeforeAllocating) {
   const uint32_t triangles = 400'000'000;
   std::memcpy(stl.data() + 80, &triangles, 4);
   EXPECT_NE(expectRefused(stl, ImportFormat::Stl, InputError::Kind::InvalidMesh, generous)
-                .find("400000000 triangles"), std::string::npos);
+                .find("400000000 triangles"),
+            std::string::npos);
 
   const std::string gltf =
       R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":12,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAA"}],)"
@@ -254,7 +262,8 @@ TEST(AssimpImport, FilesDeclaringMoreThanTheyHoldAreRefusedBeforeAllocating) {
 TEST(AssimpImport, AGltfNamingAnotherFileReadsNothingFromIt) {
   const std::string path = std::string(LIMN_SOURCE_DIR) + "/tests/unit/formats_test.cpp";
   const std::string gltf =
-      R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":")" + path + R"("}],)"
+      R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":")" + path +
+      R"("}],)"
       R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
       R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
       R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})";
