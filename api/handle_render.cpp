@@ -81,13 +81,20 @@ Answer handleRender(std::string_view body, const render::pipeline::JobLimits& li
                        o.diff + o.patches;
     const bool referenceImages =
         request.job.reference && request.job.method != render::pipeline::Method::Limit;
-    if (image && (images != 1 || referenceImages || !request.job.frames.empty())) {
+    if (image &&
+        (images != 1 || referenceImages || !request.job.frames.empty() || request.turntable)) {
       throw ApiError{406, "not_acceptable",
                      "an image answer (Accept: image/...) is one picture: ask for one output, "
                      "without reference images or frames, or accept application/json",
                      "{\"accept\":[\"application/json\"]}"};
     }
     const double parseMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    if (request.turntable) {
+      Answer answer;
+      answer.body = writeTurntable(request, limits, context, cancel);
+      answer.meshFaces = static_cast<size_t>(request.job.mesh.faceCount());
+      return answer;
+    }
 
     render::pipeline::RenderResult result =
         render::pipeline::run(request.job, limits, context, cancel);

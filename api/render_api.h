@@ -18,8 +18,17 @@ namespace limn::api {
 
 // Answer, ApiError and errorAnswer() live in api/answer.h.
 
+// "turntable": views orbiting the target, as frames of one answer (and an animated GIF).
+struct Turntable {
+  int frames = 24;
+  double elevationDeg = 20;  // else camera.orbit's elevation when it has one
+  double fps = 12;           // of the animation
+  bool animation = false;    // "turntable" in outputs: the animated GIF of the colour pass
+};
+
 struct RenderRequest {
   render::pipeline::RenderJob job;
+  std::optional<Turntable> turntable;
   render::image::Encoding encoding;  // "imageFormat", "imageQuality"
   // Notes for the client found while parsing (ignored OBJ tags, unknown fields); the answer's
   // "warnings" lists them before the engine's own.
@@ -47,6 +56,14 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
 // + the time spent here encoding, which is also written as timings.encodeMs.
 std::string writeRenderResponse(const render::pipeline::RenderResult& result,
                                 const RenderRequest& request);
+
+// The turntable's views (job.camera with its orbit's azimuth stepped round, at the turntable's
+// elevation) drawn as the rows of one comparison (render/pipeline/compare.h): the surface built
+// once, the reference and metrics per view when job.reference; the answer's "frames", "worst"
+// and the animation. Throws as handleRender's parse and run do.
+std::string writeTurntable(const RenderRequest& request, const render::pipeline::JobLimits& limits,
+                           render::pipeline::RenderContext& context,
+                           const render::CancelToken& cancel);
 
 // parse -> run -> write, with every failure turned into its JSON error answer (InputError ->
 // 4xx, Cancelled -> 504 timeout, anything else -> 500 internal). Never throws.

@@ -164,12 +164,17 @@ render::pipeline::MethodParams parseParams(const Value& params, const JobLimits&
   return out;
 }
 
-render::pipeline::Outputs readOutputs(const Value& value) {
+// `animation` (set when the list has "turntable"): /v1/render's outputs; null: the others'.
+render::pipeline::Outputs readOutputs(const Value& value, bool* animation = nullptr) {
   json::requireArray(value, "outputs");
   render::pipeline::Outputs out;
   out.color = false;
   enum Pass { Color, Mask, Depth, Normal, Wireframe, Contours, Cage, Diff, Patches };
   for (rapidjson::SizeType i = 0; i < value.Size(); ++i) {
+    if (animation && value[i].IsString() && std::string_view(value[i].GetString()) == "turntable") {
+      *animation = true;
+      continue;
+    }
     Pass pass = json::choice<Pass>(value[i], "outputs[" + std::to_string(i) + "]",
                                    {{"color", Color},
                                     {"mask", Mask},
@@ -330,6 +335,46 @@ render::mesh::ControlMesh parseMesh(const Value& mesh, const JobLimits& limits,
                                 json::quote(format));
 }
 
+// "turntable": {"frames", "elevationDeg", "fps"}, checked against the job it turns.
+Turntable readTurntable(const Value& value, const render::pipeline::RenderJob& job,
+                        const JobLimits& limits, std::vector<std::string>& warnings) {
+  json::requireObject(value, "turntable");
+  warnUnknownFields(value, "turntable", {"frames", "elevationDeg", "fps"}, warnings);
+  Turntable out;
+  if (job.camera.orbit) out.elevationDeg = job.camera.orbit->elevationDeg;
+  if (const Value* v = json::find(value, "frames"))
+    out.frames = json::integer(*v, "turntable.frames");
+  if (out.frames < 2) json::fail("turntable.frames", "turntable.frames must be at least 2");
+  if (static_cast<size_t>(out.frames) > limits.maxFrames) {
+    throw tooLarge("maxFrames", "turntable.frames",
+                   "turntable.frames " + std::to_string(out.frames) + " exceeds limit maxFrames (" +
+                       std::to_string(limits.maxFrames) + ")");
+  }
+  if (const Value* v = json::find(value, "elevationDeg")) {
+    out.elevationDeg = json::number(*v, "turntable.elevationDeg");
+    if (!(std::abs(out.elevationDeg) <= 89)) {
+      json::fail("turntable.elevationDeg", "turntable.elevationDeg must be in -89..89");
+    }
+  }
+  if (const Value* v = json::find(value, "fps")) {
+    out.fps = json::number(*v, "turntable.fps");
+    if (!(out.fps >= 1 && out.fps <= 50))
+      json::fail("turntable.fps", "turntable.fps must be in 1..50");
+  }
+  if (job.camera.eye) {
+    json::fail("camera.eye",
+               "a turntable orbits the target: place its first view with "
+               "camera.orbit (azimuthDeg, distance), or leave the eye out");
+  }
+  if (!job.frames.empty()) json::fail("turntable", "turntable and frames cannot go together");
+  if (job.method == Method::Limit) {
+    json::fail("turntable",
+               "method \"limit\" is the reference; turn a method with "
+               "\"reference\": true to see both");
+  }
+  return out;
+}
+
 RenderRequest parseDocument(const Value& root, const JobLimits& limits,
                             render::mesh::MeshCache* meshes) {
   if (!root.IsObject()) {
@@ -341,7 +386,7 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   warnUnknownFields(
       root, "",
       {"mesh", "camera", "method", "params", "shading", "outputs", "antialias", "background",
-       "reference", "imageFormat", "imageQuality", "frames", "displacement"},
+       "reference", "imageFormat", "imageQuality", "frames", "displacement", "turntable"},
       warnings);
   if (const Value* v = json::find(root, "camera")) {
     job.camera = request::parseCamera(*v, limits, warnings);
@@ -349,7 +394,8 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
   if (const Value* v = json::find(root, "method")) job.method = parseMethod(*v);
   if (const Value* v = json::find(root, "params")) job.params = parseParams(*v, limits, warnings);
   if (const Value* v = json::find(root, "shading")) job.shading = request::parseShading(*v);
-  if (const Value* v = json::find(root, "outputs")) job.outputs = readOutputs(*v);
+  bool animation = false;
+  if (const Value* v = json::find(root, "outputs")) job.outputs = readOutputs(*v, &animation);
   if (const Value* v = json::find(root, "antialias")) {
     job.outputs.antialias = request::parseAntialias(*v);
   }
@@ -390,6 +436,13 @@ RenderRequest parseDocument(const Value& root, const JobLimits& limits,
     job.displacement = request::parseDisplacement(*v, warnings);
   }
 
+  if (const Value* v = json::find(root, "turntable")) {
+    request.turntable = readTurntable(*v, job, limits, warnings);
+  }
+  if (animation && !request.turntable) {
+    json::fail("outputs", "output \"turntable\" is the animation of a \"turntable\": give one");
+  }
+  if (request.turntable) request.turntable->animation = animation;
   request::checkCameraAgainstMesh(job.camera, job.mesh);
   return request;
 }

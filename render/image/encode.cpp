@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -111,6 +112,48 @@ EncodedImage encode(const Image& image, const std::string& passName, Format form
     writeToMemory("limn.exr", spec, image.pixels.data(), result.bytes);
     result.mime = "image/x-exr";
   }
+  return result;
+}
+
+EncodedImage encodeAnimation(const std::vector<const Image*>& frames, double fps) {
+  if (frames.empty()) throw std::invalid_argument("image::encodeAnimation: no frames");
+  const int width = frames[0]->width, height = frames[0]->height;
+  std::vector<std::vector<uint8_t>> pixels;
+  std::vector<OIIO::ImageSpec> specs;
+  for (const Image* frame : frames) {
+    checkEncodable(*frame);
+    if (frame->width != width || frame->height != height) {
+      throw std::invalid_argument("image::encodeAnimation: frames of different sizes");
+    }
+    int channels = 0;
+    pixels.push_back(lossyPixels(*frame, pass::kColor, Format::Jpeg, channels));  // over white
+    OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
+    const int rate[2] = {static_cast<int>(std::lround(fps * 100)), 100};
+    spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
+    spec.attribute("oiio:Movie", 1);
+    spec.attribute("gif:LoopCount", 0);  // forever
+    specs.push_back(spec);
+  }
+  EncodedImage result;
+  result.width = width;
+  result.height = height;
+  result.mime = "image/gif";
+  OIIO::Filesystem::IOVecOutput proxy(result.bytes);
+  auto out = OIIO::ImageOutput::create("limn.gif", &proxy);
+  if (!out || !out->supports("ioproxy") || !out->supports("multiimage")) {
+    throw std::runtime_error(
+        "image::encodeAnimation: OpenImageIO cannot write animated GIF to memory");
+  }
+  if (!out->open("limn.gif", static_cast<int>(specs.size()), specs.data())) {
+    throw std::runtime_error("image::encodeAnimation: " + out->geterror());
+  }
+  for (size_t f = 0; f < specs.size(); ++f) {
+    if ((f > 0 && !out->open("limn.gif", specs[f], OIIO::ImageOutput::AppendSubimage)) ||
+        !out->write_image(OIIO::TypeDesc::UINT8, pixels[f].data())) {
+      throw std::runtime_error("image::encodeAnimation: " + out->geterror());
+    }
+  }
+  if (!out->close()) throw std::runtime_error("image::encodeAnimation: " + out->geterror());
   return result;
 }
 

@@ -21,7 +21,7 @@ struct Encoding {
 };
 
 struct EncodedImage {
-  std::string mime;  // "image/png", "image/x-exr", "image/jpeg" or "image/webp"
+  std::string mime;  // "image/png", "image/x-exr", "image/jpeg", "image/webp" or "image/gif"
   int width = 0, height = 0;
   std::vector<unsigned char> bytes;
 };
@@ -33,6 +33,11 @@ struct EncodedImage {
 // laid over white first; WebP keeps RGBA and writes grey images as RGB.
 EncodedImage encode(const Image& image, const std::string& passName, Format format,
                     int quality = kDefaultQuality);
+
+// An animated GIF of `frames` (colour passes of one size, RGBA laid over white: GIF has no
+// partial alpha), looping, at `fps` frames a second. OpenImageIO 2.4 writes animation as GIF
+// only (its WebP writer takes one image).
+EncodedImage encodeAnimation(const std::vector<const Image*>& frames, double fps);
 
 // Decodes PNG, EXR, JPEG or WebP bytes into float pixels (8-bit values scaled to [0, 1]).
 Image decode(const std::vector<unsigned char>& bytes);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "render/core/cancel.h"
 #include "render/core/image.h"
@@ -42,6 +43,9 @@ struct Metrics {
   std::optional<NormalMetrics> normal;
   std::optional<GeometryMetrics> geometry;
 };
+// The worst of several views' metrics, member by member (a turntable's summary): the largest
+// error, the smallest IoU and PSNR; a group is present when any view has it.
+Metrics worstOf(const std::vector<Metrics>& views);
 
 // Silhouette pixels of a mask: covered pixels with an uncovered 4-neighbour (outside the image
 // counts as uncovered). Both masks are at `supersample` times the output size, one channel,

@@ -64,6 +64,22 @@ void checkCompare(const CompareJob& job, const JobLimits& limits) {
   }
 }
 
+// A row's stats, warnings, timings and images from its drawing (the drawing's images are moved
+// out); the metrics and their time are the caller's.
+void fillRow(const CompareJob& job, MethodDrawing& drawing, CompareRow& row) {
+  const Approximated& approx = drawing.approx;
+  const size_t referenceTriangles = row.stats.referenceTriangles;
+  row.stats = approx.stats;
+  row.stats.controlVertices = job.mesh.vertexCount();
+  row.stats.controlFaces = job.mesh.faceCount();
+  row.stats.referenceTriangles = referenceTriangles;
+  row.warnings = approx.warnings;
+  row.timings.approxMs = approx.approxMs;
+  row.timings.rasterMs = drawing.rasterMs;
+  row.timings.totalMs = row.timings.approxMs + row.timings.rasterMs + row.timings.metricsMs;
+  row.images = selectOutputs(std::move(drawing.images), job.outputs, false);
+}
+
 // Every method for camera `c`: drawn first, then one reference hinted with all their masks,
 // then each measured against it. A drawing's images are let go as soon as its row is measured.
 void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
@@ -78,13 +94,23 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
     rows[m].method = m;
     rows[m].camera = c;
     try {
-      drawings[m] = drawMethod(choiceOf(job, m), limits, surface, camera, context, true, S, cancel);
-      oracle::mergeMaskBlocks(hint, oracle::maskBlocks(drawings[m]->images.supersampledMask, S));
+      drawings[m] =
+          drawMethod(choiceOf(job, m), limits, surface, camera, context, job.reference, S, cancel);
+      if (job.reference) {
+        oracle::mergeMaskBlocks(hint, oracle::maskBlocks(drawings[m]->images.supersampledMask, S));
+      }
     } catch (const InputError& e) {
       rows[m].error = RowError{e.kind(), e.subject(), e.what()};
     }
   }
 
+  if (!job.reference) {
+    for (size_t m = 0; m < job.methods.size(); ++m) {
+      if (drawings[m]) fillRow(job, *drawings[m], rows[m]);
+    }
+    for (CompareRow& row : rows) result.rows.push_back(std::move(row));
+    return;
+  }
   CompareReference ref{
       .camera = camera, .stats = {}, .referenceMs = 0, .images = {}, .warnings = {}};
   if (!hint.empty()) {  // else every method failed: nothing to measure
@@ -107,17 +133,9 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
       Stopwatch metricsClock;
       row.metrics =
           measureDrawing(*drawings[m], reference, surface, camera, S, job.outputs.diff, cancel);
-      const Approximated& approx = drawings[m]->approx;
-      row.stats = approx.stats;
-      row.stats.controlVertices = job.mesh.vertexCount();
-      row.stats.controlFaces = job.mesh.faceCount();
-      row.stats.referenceTriangles = reference.stats.triangles;
-      row.warnings = approx.warnings;
-      row.timings.approxMs = approx.approxMs;
-      row.timings.rasterMs = drawings[m]->rasterMs;
       row.timings.metricsMs = metricsClock.lapMs();
-      row.timings.totalMs = row.timings.approxMs + row.timings.rasterMs + row.timings.metricsMs;
-      row.images = selectOutputs(std::move(drawings[m]->images), job.outputs, false);
+      row.stats.referenceTriangles = reference.stats.triangles;
+      fillRow(job, *drawings[m], row);
       drawings[m].reset();
       cancel.check();
     }

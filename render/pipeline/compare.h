@@ -44,6 +44,9 @@ struct CompareJob {
   std::vector<CompareMethod> methods;
   int metricSupersample = 4;
   Outputs outputs{.color = false};  // images of every row and reference (none by default)
+  // false: every row drawn and not measured: no reference, rows without metrics (a turntable
+  // of /v1/render without "reference": its frames are the rows of one method).
+  bool reference = true;
 };
 
 // Why a row could not be made (an InputError of the engine, as the api layer maps them).
@@ -63,7 +66,7 @@ struct CompareRow {
   std::vector<std::string> warnings;
 };
 
-// The reference of one camera, shared by its rows.
+// The reference of one camera, shared by its rows (none when CompareJob::reference is false).
 struct CompareReference {
   Camera camera;  // as resolved
   oracle::ReferenceStats stats;

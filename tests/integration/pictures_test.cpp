@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -301,6 +302,58 @@ TEST_F(PicturesServer, AcceptAnImageTypeAndTheAnswerIsThePicture) {
   HttpResponse refused = post(port(), "/v1/render", two, {{"Accept", "image/png"}});
   EXPECT_EQ(refused.status, 406);
   EXPECT_EQ(refused.header("Content-Type"), "application/json");
+}
+
+// A turntable's views are the renders of the same views: the same masks, the same colours, the
+// same metrics; "worst" is the worst of them; the animation is a GIF of every view.
+TEST_F(PicturesServer, ATurntablesFramesAreTheRendersOfItsViews) {
+  const std::string mesh =
+      R"({"format":"obj","scheme":"catmull-clark","data":")" + torusObj() + "\"}";
+  auto body = [&](const std::string& camera, const std::string& more,
+                  const std::string& outputs = R"(["color","mask"])") {
+    return R"({"mesh":)" + mesh + R"(,"camera":)" + camera + R"(,"method":"adaptive","outputs":)" +
+           outputs + R"(,"reference":true)" + more + "}";
+  };
+  auto turntable =
+      answer("/v1/render", body(R"({"width":96,"height":96,"orbit":{"azimuthDeg":10}})",
+                                R"(,"turntable":{"frames":4,"elevationDeg":25})"));
+  const rapidjson::Value& frames = (*turntable)["frames"];
+  ASSERT_EQ(frames.Size(), 4u);
+  double worstOutline = 0;
+  for (rapidjson::SizeType k = 0; k < frames.Size(); ++k) {
+    const std::string camera = R"({"width":96,"height":96,"orbit":{"azimuthDeg":)" +
+                               std::to_string(10 + 90 * k) + R"(,"elevationDeg":25}})";
+    auto alone = answer("/v1/render", body(camera, ""));
+    EXPECT_EQ(imageOf(frames[k]["images"], "mask").pixels,
+              imageOf((*alone)["images"], "mask").pixels)
+        << "view " << k;
+    EXPECT_EQ(imageOf(frames[k]["images"], "color").pixels,
+              imageOf((*alone)["images"], "color").pixels)
+        << "view " << k;
+    const double outline = frames[k]["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble();
+    EXPECT_DOUBLE_EQ(outline, (*alone)["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble());
+    worstOutline = std::max(worstOutline, outline);
+  }
+  EXPECT_DOUBLE_EQ((*turntable)["worst"]["silhouette"]["outlineHausdorffPx"].GetDouble(),
+                   worstOutline);
+  // The views differ (the torus is not round about +y).
+  EXPECT_NE(imageOf(frames[0]["images"], "mask").pixels,
+            imageOf(frames[1]["images"], "mask").pixels);
+
+  auto animated = answer("/v1/render", body(R"({"width":64,"height":64})",
+                                            R"(,"turntable":{"frames":3})", R"(["turntable"])"));
+  ASSERT_TRUE((*animated)["turntable"].HasMember("animation"));
+  const std::vector<unsigned char> gif =
+      decodeBase64((*animated)["turntable"]["animation"]["data"].GetString());
+  ASSERT_GT(gif.size(), 6u);
+  EXPECT_EQ(std::string(gif.begin(), gif.begin() + 6), "GIF89a");
+  EXPECT_TRUE((*animated)["frames"][0]["images"].ObjectEmpty());  // only the animation was asked
+
+  auto eye = answer("/v1/render", body(R"({"eye":[3,2,3]})", R"(,"turntable":{"frames":3})"), 400);
+  EXPECT_STREQ((*eye)["error"]["detail"]["field"].GetString(), "camera.eye");
+  answer("/v1/render", body("{}", "", R"(["turntable"])"), 400);
+  auto many = answer("/v1/render", body("{}", R"(,"turntable":{"frames":100000})"), 413);
+  EXPECT_STREQ((*many)["error"]["detail"]["limit"].GetString(), "maxFrames");
 }
 
 }  // namespace
