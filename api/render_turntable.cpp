@@ -46,15 +46,15 @@ void checkPixels(const RenderRequest& request, const render::pipeline::JobLimits
   const render::pipeline::Outputs& o = request.job.outputs;
   const size_t perView = o.color + o.mask + o.depth + o.normal + o.wireframe + o.contours + o.cage +
                          o.diff + o.patches + request.turntable->animation;
-  const size_t side = static_cast<size_t>(request.job.camera.width.value_or(render::kDefaultImageSide)) *
-                      request.job.camera.height.value_or(render::kDefaultImageSide);
+  const size_t side =
+      static_cast<size_t>(request.job.camera.width.value_or(render::kDefaultImageSide)) *
+      request.job.camera.height.value_or(render::kDefaultImageSide);
   const size_t pixels = request.turntable->frames * side * std::max<size_t>(perView, 1) *
                         (request.job.reference ? 2 : 1);
   if (pixels > limits.maxFramePixels) {
     throw tooLarge("maxFramePixels", "turntable.frames",
-                   "a turntable of " + std::to_string(request.turntable->frames) +
-                       " views holds " + std::to_string(pixels) +
-                       " image pixels, over limit maxFramePixels (" +
+                   "a turntable of " + std::to_string(request.turntable->frames) + " views holds " +
+                       std::to_string(pixels) + " image pixels, over limit maxFramePixels (" +
                        std::to_string(limits.maxFramePixels) + ")");
   }
 }
@@ -94,8 +94,8 @@ void writeAnimation(json::Writer& w, const CompareResult& result, const Turntabl
   w.EndObject();
 }
 
-void writeView(json::Writer& w, const RenderRequest& request, const CompareResult& result,
-               size_t k, std::vector<std::string>& warnings) {
+void writeView(json::Writer& w, const RenderRequest& request, const CompareResult& result, size_t k,
+               std::vector<std::string>& warnings) {
   const render::pipeline::CompareRow& row = result.rows[k];
   w.StartObject();
   w.Key("azimuthDeg");
@@ -146,7 +146,8 @@ std::string writeTurntable(const RenderRequest& request, const render::pipeline:
                            render::pipeline::RenderContext& context,
                            const render::CancelToken& cancel) {
   checkPixels(request, limits);
-  const CompareResult result = render::pipeline::compare(compareJobOf(request), limits, context, cancel);
+  const CompareResult result =
+      render::pipeline::compare(compareJobOf(request), limits, context, cancel);
   const Turntable& turntable = *request.turntable;
   std::vector<std::string> warnings = request.warnings;
 

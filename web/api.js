@@ -76,17 +76,41 @@ export async function getText(path) {
   return response.text();
 }
 
-// A mesh the page renders: its wire form ({format, data, scheme} or the JSON form) and, once
-// uploaded, the server's id for it.
+// POSTs a file's bytes as they are (`query`: "?format=glb&scheme=loop"); resolves to the JSON
+// answer, rejects with an ApiProblem.
+export async function postFile(path, bytes, query, { signal } = {}) {
+  const response = await fetch(path + query, {
+    method: "POST", headers: { "Content-Type": "application/octet-stream" }, body: bytes, signal,
+  });
+  if (!response.ok) {
+    throw new ApiProblem(response.status, await response.json().catch(() => null),
+                         Number(response.headers.get("Retry-After")) || 1);
+  }
+  return response.json();
+}
+
+// The mesh file formats the server reads through Assimp, by file extension.
+export const meshFileFormats = ["glb", "gltf", "ply", "stl", "fbx", "dae", "3ds", "off"];
+
+// A mesh the page renders: its wire form ({format, data, scheme} or the JSON form), or a mesh
+// file sent as it is (`file`: {bytes, format, scheme}; the scheme null lets the server choose),
+// and, once uploaded, the server's id for it.
 export class UploadedMesh {
-  constructor(wire) {
+  constructor(wire, file = null) {
     this.wire = wire;
+    this.file = file;
     this.id = null;
     this.info = null;  // {id, vertices, faces, scheme, warnings}
   }
 
   async upload(signal) {
-    this.info = await post("/v1/meshes", { mesh: this.wire }, { signal });
+    if (this.file) {
+      const query = `?format=${this.file.format}` +
+          (this.file.scheme ? `&scheme=${encodeURIComponent(this.file.scheme)}` : "");
+      this.info = await postFile("/v1/meshes", this.file.bytes, query, { signal });
+    } else {
+      this.info = await post("/v1/meshes", { mesh: this.wire }, { signal });
+    }
     this.id = this.info.id;
     return this.info;
   }

@@ -3,7 +3,7 @@
 // from the server (POST /v1/render; POST /v1/implicit for scenes); while the camera is dragged the page draws the approximation's triangles
 // itself (POST /v1/tessellate, WebGL 2: glview.js), or, without WebGL or before they arrive,
 // shows small renders, and the full-size picture follows when the drag ends. See docs/web.md.
-import { ApiProblem, UploadedMesh, getJson, getText, post, postBinary } from "/api.js";
+import { ApiProblem, UploadedMesh, getJson, getText, meshFileFormats, post, postBinary } from "/api.js";
 import { MeshView, parseGlb } from "/glview.js";
 
 const $ = (id) => document.getElementById(id);
@@ -16,6 +16,7 @@ const LOCAL_MAX_TRIANGLES = 400_000;  // larger approximations are previewed by 
 const page = (window.limnPage = {
   renders: 0,            // full-size pictures shown
   previews: 0,           // drag previews shown (small renders from the server)
+  turntables: 0,         // turntable animations shown
   localFrames: 0,        // drag frames the page drew itself (WebGL)
   firstPictureMs: null,  // performance.now() when the first full-size picture was shown
   dragToFullMs: null,    // from the last drag's end to its full-size picture
@@ -30,7 +31,7 @@ const page = (window.limnPage = {
   localSnapshot() {
     state.glView.draw(orbitCamera(), fullSize(), {
       surface: $("draw-surface").checked, cage: $("draw-cage").checked,
-      flat: $("shading").value === "flat",
+      flat: $("shading").value === "flat", opaque: $("background").value !== "transparent",
     });
     return $("gl-canvas").toDataURL("image/png");
   },
@@ -40,6 +41,7 @@ const state = {
   examples: [],
   mesh: null,           // UploadedMesh
   meshText: null,       // OBJ text or JSON mesh object, for the client-side cage
+  meshFile: null,       // {bytes, format, name} of a mesh file the server reads (glb, ply, ...)
   view: { ...DEFAULT_VIEW },
   full: null,           // AbortController of the full-size render in flight
   preview: { busy: false, again: false },
@@ -47,6 +49,7 @@ const state = {
   frame: null,          // {target, radius, fovYDeg} of the mesh, from the last answer's camera
   glView: null,         // MeshView, when the browser has WebGL 2
   tessellation: null,   // AbortController of the POST /v1/tessellate in flight
+  turntableTimer: null,  // the interval that plays a turntable's views
   scene: null,          // an implicit scene ({field, ...}: a /v1/implicit request) instead of a mesh
 };
 
@@ -112,14 +115,15 @@ function cameraFor(size) {
 function renderBody(mesh, size, compare) {
   const outputs = [mainOutput()];
   if (compare) outputs.push("diff");
+  const background = $("background").value;
   if (state.scene) {
-    return { field: state.scene.field, camera: cameraFor(size), outputs, reference: compare,
+    return { field: state.scene.field, camera: cameraFor(size), outputs, reference: compare, background,
              shading: $("shading").value === "flat" ? "flat" : "smooth",
              polygonizer: { method: $("polygonizer").value, resolution: Number($("resolution").value),
                             flatness: Number($("flatness").value) } };
   }
   const body = { mesh, camera: cameraFor(size), method: $("method").value, params: methodParams(),
-                 shading: $("shading").value, outputs, reference: compare };
+                 shading: $("shading").value, outputs, reference: compare, background };
   const displacement = displacementOf(body.method);
   if (displacement) body.displacement = displacement;
   return body;
@@ -156,6 +160,7 @@ function showImage(img, image) {
 async function renderFull() {
   if (!state.mesh) return;
   state.full?.abort();
+  stopTurntable();
   const controller = (state.full = new AbortController());
   const compare = comparing();
   const sentView = { ...state.view };
@@ -310,7 +315,7 @@ function drawLocal() {
     if (!state.glView?.ready || !state.frame) return;
     state.glView.draw(orbitCamera(), fullSize(), {
       surface: $("draw-surface").checked, cage: $("draw-cage").checked,
-      flat: $("shading").value === "flat",
+      flat: $("shading").value === "flat", opaque: $("background").value !== "transparent",
     });
     $("gl-canvas").hidden = false;
     $("picture").classList.add("hidden-surface");
@@ -515,6 +520,8 @@ async function useScene(request, label) {
   state.scene = request;
   state.mesh = new SceneSource(request);
   state.meshText = null;
+  state.meshFile = null;
+  stopTurntable();
   state.frame = null;
   if (state.glView) state.glView.setCage([], []);
   const polygonizer = request.polygonizer || {};
@@ -531,20 +538,38 @@ async function useScene(request, label) {
 }
 
 async function useMesh(source, label) {
-  state.full?.abort();
-  state.scene = null;
-  showSourceControls();
+  state.meshFile = null;
   state.meshText = source;
-  state.mesh = new UploadedMesh(wireMesh(source));
-  state.frame = null;  // until the first answer for this mesh
   if (state.glView) {
     const { points, faces } = cageOf(source);
     state.glView.setCage(points, faces);
   }
+  await uploadAndRender(new UploadedMesh(wireMesh(source)), label);
+}
+
+// A file of a format the server reads (glTF, PLY, STL, ...), sent as it is. The server chooses
+// the scheme from its faces unless the person picked one for this file; the page has no cage
+// of it to draw itself.
+async function useMeshFile(file, scheme = null) {
+  state.meshText = null;
+  state.meshFile = file;
+  if (state.glView) state.glView.setCage([], []);
+  const uploaded = new UploadedMesh(null, { bytes: file.bytes, format: file.format, scheme });
+  if (await uploadAndRender(uploaded, file.name)) $("scheme").value = uploaded.info.scheme;
+}
+
+// Uploads the mesh and renders it; false (the error shown) when the upload was refused.
+async function uploadAndRender(uploaded, label) {
+  state.full?.abort();
+  stopTurntable();
+  state.scene = null;
+  showSourceControls();
+  state.mesh = uploaded;
+  state.frame = null;  // until the first answer for this mesh
   clearErrors();
   setBusy("uploading the mesh…");
   try {
-    const info = await state.mesh.upload();
+    const info = await uploaded.upload();
     $("mesh-info").textContent = `${label}: ${info.vertices} vertices, ${info.faces} faces` +
         (info.warnings.length ? ` (${info.warnings.length} warnings)` : "");
     $("mesh-info").title = info.warnings.join("\n");
@@ -553,10 +578,11 @@ async function useMesh(source, label) {
     state.mesh = null;
     $("mesh-info").textContent = "";
     showError(problem);
-    return;
+    return false;
   }
   hideContours();
   await renderFull();
+  return true;
 }
 
 async function loadExample(name) {
@@ -578,6 +604,15 @@ async function loadExample(name) {
 }
 
 async function loadFile(file) {
+  const extension = (file.name.match(/\.([^.]+)$/) || ["", ""])[1].toLowerCase();
+  if (meshFileFormats.includes(extension)) {
+    $("example").value = "";
+    firstView = { ...DEFAULT_VIEW };
+    state.view = { ...firstView };
+    describeView();
+    await useMeshFile({ bytes: await file.arrayBuffer(), format: extension, name: file.name });
+    return;
+  }
   const text = await file.text();
   let source = text;
   if (/\.json$/i.test(file.name) || /^\s*\{/.test(text)) {
@@ -603,6 +638,51 @@ async function loadFile(file) {
   }
   $("example").value = "";
   await useMesh(source, file.name);
+}
+
+// ---------------------------------------------------------------- turntable
+
+// Views orbiting the mesh from the current one, played over the picture (each view's own PNG,
+// anti-aliased like the picture: the answer's GIF, with its 256 colours, is for other clients)
+// until the next render (a drag, a changed control).
+async function playTurntable() {
+  if (!state.mesh || state.scene) return;
+  state.full?.abort();
+  stopTurntable();
+  const controller = (state.full = new AbortController());
+  const frames = Number($("turntable-frames").value);
+  setBusy(`rendering a turntable of ${frames} views…`);
+  try {
+    const size = Math.min(fullSize(), 384);
+    const answer = await state.mesh.withId(
+        (mesh) => post("/v1/render", {
+          ...renderBody(mesh, size, false),
+          turntable: { frames, elevationDeg: state.view.elevationDeg },
+        }, { signal: controller.signal }),
+        controller.signal);
+    if (controller.signal.aborted) return;
+    clearErrors();
+    const views = answer.frames.filter((f) => f.images).map((f) => imageUrl(
+        f.images[mainOutput()] || f.images.color));
+    let k = 0;
+    const show = () => { $("turntable-picture").src = views[k++ % views.length]; };
+    show();
+    $("turntable-picture").hidden = false;
+    state.turntableTimer = setInterval(show, 1000 / answer.turntable.fps);
+    page.turntables += 1;
+  } catch (problem) {
+    if (problem.name !== "AbortError") showError(problem);
+  } finally {
+    if (state.full === controller) {
+      state.full = null;
+      setBusy(null);
+    }
+  }
+}
+
+function stopTurntable() {
+  clearInterval(state.turntableTimer);
+  $("turntable-picture").hidden = true;
 }
 
 // ---------------------------------------------------------------- camera
@@ -706,8 +786,14 @@ function bindControls() {
   for (const id of ["scheme", "boundary", "crease-method"]) {
     $(id).addEventListener("change", () => {
       if (state.meshText !== null) useMesh(state.meshText, $("mesh-info").textContent.split(":")[0]);
+      if (state.meshFile !== null && id === "scheme") useMeshFile(state.meshFile, $("scheme").value);
     });
   }
+  $("background").addEventListener("change", () => {
+    $("view").classList.toggle("transparent", $("background").value === "transparent");
+    renderFull();
+  });
+  $("turntable").addEventListener("click", playTurntable);
   $("level").addEventListener("input", () => { $("level-value").textContent = $("level").value; });
   $("method").addEventListener("change", showMethodParams);
   for (const id of ["method", "level", "engine", "dicing-rate", "contour-mode", "presubdivide",

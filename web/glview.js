@@ -198,12 +198,13 @@ export class MeshView {
     if (this[vao]) this.gl.deleteVertexArray(this[vao]);
   }
 
-  // camera: {eye, target, up, fovYDeg, near, far}; what: {surface, cage, flat}.
+  // camera: {eye, target, up, fovYDeg, near, far}; what: {surface, cage, flat, opaque} (opaque:
+  // a white background, as the server's "background": "white").
   draw(camera, size, what) {
     const gl = this.gl, canvas = this.canvas;
     if (canvas.width !== size) canvas.width = canvas.height = size;
     gl.viewport(0, 0, size, size);
-    gl.clearColor(0, 0, 0, 0);
+    if (what.opaque) gl.clearColor(1, 1, 1, 1); else gl.clearColor(0, 0, 0, 0);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.enable(gl.DEPTH_TEST);
     const viewProj = viewProjection(camera, 1);

@@ -15,8 +15,8 @@ void worse(std::optional<double>& worst, const std::optional<double>& value) {
 
 // The group `member` of every view that has it, folded by `fold` into the first one's copy.
 template <class Group, class Fold>
-std::optional<Group> worstGroup(const std::vector<Metrics>& views, std::optional<Group> Metrics::*member,
-                                Fold fold) {
+std::optional<Group> worstGroup(const std::vector<Metrics>& views,
+                                std::optional<Group> Metrics::*member, Fold fold) {
   std::optional<Group> worst;
   for (const Metrics& view : views) {
     const std::optional<Group>& group = view.*member;
@@ -34,14 +34,15 @@ std::optional<Group> worstGroup(const std::vector<Metrics>& views, std::optional
 
 Metrics worstOf(const std::vector<Metrics>& views) {
   Metrics out;
-  out.silhouette = worstGroup(views, &Metrics::silhouette, [](SilhouetteMetrics& w, const SilhouetteMetrics& v) {
-    worse(w.hausdorffPx, v.hausdorffPx);
-    worse(w.meanPx, v.meanPx);
-    lower(w.iou, v.iou);
-    w.mismatchPx = std::max(w.mismatchPx, v.mismatchPx);
-    worse(w.outlineHausdorffPx, v.outlineHausdorffPx);
-    worse(w.outlineMeanPx, v.outlineMeanPx);
-  });
+  out.silhouette =
+      worstGroup(views, &Metrics::silhouette, [](SilhouetteMetrics& w, const SilhouetteMetrics& v) {
+        worse(w.hausdorffPx, v.hausdorffPx);
+        worse(w.meanPx, v.meanPx);
+        lower(w.iou, v.iou);
+        w.mismatchPx = std::max(w.mismatchPx, v.mismatchPx);
+        worse(w.outlineHausdorffPx, v.outlineHausdorffPx);
+        worse(w.outlineMeanPx, v.outlineMeanPx);
+      });
   out.image = worstGroup(views, &Metrics::image, [](ColorMetrics& w, const ColorMetrics& v) {
     worse(w.rmse, v.rmse);
     lower(w.psnr, v.psnr);
@@ -55,12 +56,13 @@ Metrics worstOf(const std::vector<Metrics>& views) {
     worse(w.meanDeg, v.meanDeg);
     worse(w.maxDeg, v.maxDeg);
   });
-  out.geometry = worstGroup(views, &Metrics::geometry, [](GeometryMetrics& w, const GeometryMetrics& v) {
-    worse(w.maxDist, v.maxDist);
-    worse(w.meanDist, v.meanDist);
-    worse(w.relMaxDist, v.relMaxDist);
-    worse(w.relMeanDist, v.relMeanDist);
-  });
+  out.geometry =
+      worstGroup(views, &Metrics::geometry, [](GeometryMetrics& w, const GeometryMetrics& v) {
+        worse(w.maxDist, v.maxDist);
+        worse(w.meanDist, v.meanDist);
+        worse(w.relMaxDist, v.relMaxDist);
+        worse(w.relMeanDist, v.relMeanDist);
+      });
   return out;
 }
 

@@ -319,6 +319,71 @@ describe("limn's page", () => {
     await shot("error-broken-obj");
   });
 
+  it("reads mesh files of other formats: OFF polygons, a binary STL of triangles", async () => {
+    // An OFF cube (quads): Catmull-Clark, chosen by the server from its faces.
+    const off = "OFF\n8 6 0\n-1 -1 1\n1 -1 1\n-1 1 1\n1 1 1\n-1 1 -1\n1 1 -1\n-1 -1 -1\n" +
+                "1 -1 -1\n4 0 1 3 2\n4 2 3 5 4\n4 4 5 7 6\n4 6 7 1 0\n4 1 7 5 3\n4 6 0 2 4\n";
+    let renders = await page.evaluate(() => window.limnPage.renders);
+    await page.setInputFiles("#upload", { name: "cube.off", mimeType: "application/octet-stream",
+                                          buffer: Buffer.from(off) });
+    await page.waitForFunction(() => /cube\.off: 8 vertices, 6 faces/.test(
+        document.querySelector("#mesh-info").textContent));
+    await waitForRenders(renders + 1);
+    assert.equal(await page.$eval("#scheme", (el) => el.value), "catmull-clark");
+    assert.ok(await inkFraction("#picture") > 0.05, "the OFF cube is not drawn");
+
+    // A binary STL tetrahedron: every face a triangle, so Loop; its corners welded into 4.
+    const corners = [[1, 1, 1], [-1, -1, 1], [-1, 1, -1], [1, -1, -1]];
+    const faces = [[0, 1, 3], [0, 2, 1], [0, 3, 2], [1, 2, 3]];
+    const stl = Buffer.alloc(84 + 50 * faces.length);
+    stl.writeUInt32LE(faces.length, 80);
+    faces.forEach((face, f) => {
+      face.forEach((v, c) => corners[v].forEach((x, k) => stl.writeFloatLE(x, 84 + 50 * f + 12 + 12 * c + 4 * k)));
+    });
+    renders = await page.evaluate(() => window.limnPage.renders);
+    await page.setInputFiles("#upload", { name: "tetra.stl", mimeType: "model/stl", buffer: stl });
+    await page.waitForFunction(() => /tetra\.stl: 4 vertices, 4 faces/.test(
+        document.querySelector("#mesh-info").textContent));
+    await waitForRenders(renders + 1);
+    assert.equal(await page.$eval("#scheme", (el) => el.value), "loop");
+    await shot("mesh-file-stl");
+  });
+
+  it("shows a transparent background and plays a turntable", async () => {
+    let renders = await set("#background", "transparent");
+    await waitForRenders(renders + 1);
+    const cornerAlpha = await page.$eval("#picture", (img) => {
+      const canvas = document.createElement("canvas");
+      canvas.width = img.naturalWidth;
+      canvas.height = img.naturalHeight;
+      const ctx = canvas.getContext("2d");
+      ctx.drawImage(img, 0, 0);
+      return ctx.getImageData(1, 1, 1, 1).data[3];
+    });
+    assert.equal(cornerAlpha, 0, "the picture's background is not transparent");
+    await shot("transparent-background");
+    renders = await set("#background", "white");
+    await waitForRenders(renders + 1);
+
+    const turntables = await page.evaluate(() => window.limnPage.turntables);
+    await page.selectOption("#turntable-frames", "12");
+    await page.click("#turntable");
+    await page.waitForFunction((n) => window.limnPage.turntables > n, turntables,
+                               { timeout: 120_000 });
+    assert.ok(await page.isVisible("#turntable-picture"));
+    // It plays: the picture changes from view to view.
+    const first = await page.$eval("#turntable-picture", (img) => img.src);
+    assert.match(first, /^data:image\/png;base64,/);
+    await page.waitForFunction((src) => document.querySelector("#turntable-picture").src !== src,
+                               first, { timeout: 10_000 });
+    await shot("turntable");
+    // The next render puts the picture back.
+    renders = await set("#shading", "flat");
+    await waitForRenders(renders + 1);
+    assert.ok(!(await page.isVisible("#turntable-picture")));
+    await set("#shading", "smooth");
+  });
+
   it("compares with the reference: metrics, reference and diff", async () => {
     await page.selectOption("#example", "pawn");
     await page.waitForFunction(() => /Pawn/.test(document.querySelector("#mesh-info").textContent));
