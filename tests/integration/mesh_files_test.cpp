@@ -8,6 +8,8 @@
 #include <rapidjson/document.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -217,6 +219,27 @@ TEST_F(MeshFilesServer, BadFilesAre422NamingTheFormatAndTheServerKeepsServing) {
   EXPECT_STREQ((*bad64)["error"]["detail"]["field"].GetString(), "mesh.dataBase64");
   // Still serving.
   answer("/v1/render", maskRequest(fileMesh("off", writeOff(quadCage()))));
+}
+
+// A COLLADA file (found by fuzz/mesh_import) on which Assimp 5.2 grows without bound: the
+// worker process that reads it passes its ceiling and is killed, the request gets its 500, and
+// the server goes on with the next file.
+TEST(MeshFilesIsolation, AFileThatExhaustsAssimpCostsOnlyItsRequest) {
+  std::ifstream in(std::string(LIMN_SOURCE_DIR) +
+                       "/fuzz/corpus/mesh_import/regression-collada-grows-without-bound",
+                   std::ios::binary);
+  std::string dae((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(dae.size(), 100u);
+  dae.erase(0, 1);  // the fuzz input's first byte picks the format
+  auto server = ServerProcess::withConfig(R"({"limits": {"maxWorkerMemoryBytes": 536870912}})");
+  HttpResponse crashed =
+      post(server.port(), "/v1/meshes", dae, {{"Content-Type", "model/vnd.collada+xml"}});
+  EXPECT_EQ(crashed.status, 500) << crashed.body.substr(0, 300);
+  EXPECT_NE(crashed.body.find("worker_crashed"), std::string::npos) << crashed.body.substr(0, 300);
+  HttpResponse next =
+      post(server.port(), "/v1/meshes", writeOff(quadCage()), {{"Content-Type", "model/x-off"}});
+  EXPECT_EQ(next.status, 200) << next.body.substr(0, 300);
+  EXPECT_EQ(server.terminate(), 0);
 }
 
 TEST_F(MeshFilesServer, AJobTakesAFileOnlyByTheIdOfItsUpload) {
