@@ -231,7 +231,7 @@ TEST(MeshFilesIsolation, AFileThatExhaustsAssimpCostsOnlyItsRequest) {
   std::string dae((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(dae.size(), 100u);
   dae.erase(0, 1);  // the fuzz input's first byte picks the format
-  auto server = ServerProcess::withConfig(R"({"limits": {"maxWorkerMemoryBytes": 536870912}})");
+  auto server = ServerProcess::withConfig(R"({"limits": {"maxWorkerMemoryBytes": 1073741824}})");
   HttpResponse crashed =
       post(server.port(), "/v1/meshes", dae, {{"Content-Type", "model/vnd.collada+xml"}});
   EXPECT_EQ(crashed.status, 500) << crashed.body.substr(0, 300);
