@@ -4,7 +4,8 @@
 // over it, so that orbiting runs at the display's frame rate without a request per frame. The
 // server's full-size picture replaces it when the drag ends.
 
-// render/core/shading.h
+// render/core/shading.h: sRGB albedos, shaded in linear light, written as sRGB (the canvas
+// shows its values as sRGB, as the server's PNGs hold them).
 const FRONT = [0.80, 0.62, 0.38], BACK = [0.40, 0.55, 0.80];
 const AMBIENT = 0.12, DIFFUSE = 0.78, SPECULAR = 0.25, SHININESS = 40.0;
 const CAGE = [0.12, 0.23, 0.58];
@@ -28,6 +29,12 @@ uniform bool uFlat;
 in vec3 vPosition;
 in vec3 vNormal;
 out vec4 color;
+vec3 toLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+vec3 toSrgb(vec3 c) {
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
 void main() {
   vec3 n = uFlat ? normalize(cross(dFdx(vPosition), dFdy(vPosition))) : normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
@@ -37,10 +44,10 @@ void main() {
   // Flat: the screen-space normal faces the eye.
   if (uFlat) ndotv = abs(ndotv);
   else if (!gl_FrontFacing) ndotv = -ndotv;
-  vec3 albedo = gl_FrontFacing ? vec3(${FRONT}) : vec3(${BACK});
+  vec3 albedo = toLinear(gl_FrontFacing ? vec3(${FRONT}) : vec3(${BACK}));
   float c = max(ndotv, 0.0);
   vec3 rgb = albedo * (${AMBIENT} + ${DIFFUSE} * c) + ${SPECULAR} * pow(c, ${SHININESS.toFixed(1)});
-  color = vec4(clamp(rgb, 0.0, 1.0), 1.0);
+  color = vec4(toSrgb(clamp(rgb, 0.0, 1.0)), 1.0);
 }`;
 
 const LINE_VS = `#version 300 es

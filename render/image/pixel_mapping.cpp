@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "render/core/shading.h"
+
 namespace limn::render::image {
 
 namespace {
@@ -14,6 +16,30 @@ uint8_t quantize(float v) {
   // Round half away from zero, as std::lround would, without its library call (a tenth of a
   // small request's CPU time went to lround): in double, v * 255 + 0.5 is exact for a float v.
   return static_cast<uint8_t>(static_cast<double>(v) * 255.0 + 0.5);
+}
+
+// The colour passes hold linear light; 8-bit files hold sRGB (render/core/shading.h). Alpha stays
+// linear coverage. A table of 4096 linear steps: sRGB's steepest slope (12.92, near black) makes
+// a step at most 0.8 of an 8-bit level, and a pow per channel would cost as much as the PNG.
+uint8_t srgbByte(float v) {
+  constexpr int kSteps = 4096;
+  static const std::vector<uint8_t> table = [] {
+    std::vector<uint8_t> t(kSteps);
+    for (int i = 0; i < kSteps; ++i) t[i] = quantize(shading::linearToSrgb(i / float(kSteps - 1)));
+    return t;
+  }();
+  if (!(v > 0.0f)) return 0;
+  if (v >= 1.0f) return 255;
+  return table[static_cast<int>(v * (kSteps - 1) + 0.5f)];
+}
+
+std::vector<uint8_t> srgbEncoded(const Image& image) {
+  std::vector<uint8_t> out(image.pixels.size());
+  const bool rgba = image.channels == 4;
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    out[i] = rgba && i % 4 == 3 ? quantize(image.pixels[i]) : srgbByte(image.pixels[i]);
+  }
+  return out;
 }
 
 std::vector<uint8_t> clamped(const Image& image) {
@@ -62,7 +88,10 @@ std::vector<uint8_t> normalRgb(const Image& image) {
 std::vector<uint8_t> to8Bit(const Image& image, const std::string& passName) {
   if (passName == pass::kDepth) return depthGrey(image);
   if (passName == pass::kNormal) return normalRgb(image);
-  return clamped(image);
+  const bool shaded = passName == pass::kColor || passName == pass::kWireframe ||
+                      passName == pass::kContours || passName == pass::kCage ||
+                      passName == pass::kPatches;
+  return shaded ? srgbEncoded(image) : clamped(image);
 }
 
 }  // namespace limn::render::image

@@ -20,9 +20,17 @@ std::string glslVec3(const float v[3]) {
   return "vec3(" + glslFloat(v[0]) + ", " + glslFloat(v[1]) + ", " + glslFloat(v[2]) + ")";
 }
 
+// shading::srgbToLinear in GLSL: the shaders take sRGB colours (albedos, line colours) and
+// write linear light.
+const char* kToLinear = R"(
+vec3 toLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+)";
+
 std::string shadingConstants() {
   using namespace shading;
-  return "const vec3 kFrontAlbedo = " + glslVec3(kFrontAlbedo) + ";\n" +
+  return std::string(kToLinear) + "const vec3 kFrontAlbedo = " + glslVec3(kFrontAlbedo) + ";\n" +
          "const vec3 kBackAlbedo = " + glslVec3(kBackAlbedo) + ";\n" +
          "const float kAmbient = " + glslFloat(kAmbient) + ";\n" +
          "const float kDiffuse = " + glslFloat(kDiffuse) + ";\n" +
@@ -101,7 +109,7 @@ void main() {
   // a fringe with the back albedo. There the light falls to zero, as at the limit's outline.
   float ndotv = dot(n, toEye);
   vec3 front = vAlbedo.x >= 0.0 ? vAlbedo : kFrontAlbedo;
-  vec3 albedo = gl_FrontFacing ? front : kBackAlbedo;
+  vec3 albedo = toLinear(gl_FrontFacing ? front : kBackAlbedo);
   float c = max(gl_FrontFacing ? ndotv : -ndotv, 0.0);
   float spec = pow(c, kShininess);
   vec3 rgb = clamp(albedo * (kAmbient + kDiffuse * c) + kSpecular * spec, 0.0, 1.0);
@@ -122,10 +130,12 @@ void main() { gl_Position = uViewProjection * vec4(aPosition, 1.0); }
 }
 
 std::string solidFragmentShader() {
-  return R"(#version 450 core
-uniform vec4 uColor;
+  return std::string(R"(#version 450 core
+uniform vec4 uColor;  // sRGB, straight alpha
 layout(location = 0) out vec4 oColor;
-void main() { oColor = uColor; }
+)") + kToLinear +
+         R"(
+void main() { oColor = vec4(toLinear(uColor.rgb), uColor.a); }
 )";
 }
 
@@ -188,10 +198,12 @@ void main() {
 }
 
 std::string lineFragmentShader() {
-  return R"(#version 450 core
-flat in vec4 gColor;
+  return std::string(R"(#version 450 core
+flat in vec4 gColor;  // sRGB, straight alpha
 layout(location = 3) out vec4 oOverlay;
-void main() { oOverlay = gColor; }
+)") + kToLinear +
+         R"(
+void main() { oOverlay = vec4(toLinear(gColor.rgb), gColor.a); }
 )";
 }
 

@@ -920,7 +920,8 @@ TEST(RenderResponse, HasTheDesignShape) {
   EXPECT_EQ(decoded.width, 4);
   EXPECT_EQ(decoded.height, 3);
   EXPECT_NEAR(decoded.at(1, 2, 0), 1.0f, 1e-6);
-  EXPECT_NEAR(decoded.at(0, 0, 0), 0.5f, 1.0f / 255);
+  // Linear 0.5 is written as sRGB (docs/engine.md, "Colour is linear light").
+  EXPECT_NEAR(decoded.at(0, 0, 0), render::shading::linearToSrgb(0.5f), 1.0f / 255);
   EXPECT_TRUE(images.HasMember("mask"));
 
   const rapidjson::Value& ref = doc["reference"]["images"];

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "render/core/shading.h"
 #include "render/image/encode.h"
 #include "render/image/pixel_mapping.h"
 
@@ -38,6 +39,8 @@ TEST(ImageEncode, ExrRoundTripIsExactForEveryChannelCount) {
   }
 }
 
+// The colour passes hold linear light and are written as sRGB (alpha as it is): decoded, a PNG
+// gives the sRGB values back, within the 8-bit step.
 TEST(ImageEncode, PngColorRoundTripWithinOneLevel) {
   Image img(16, 9, 4);
   for (int y = 0; y < 9; ++y)
@@ -56,8 +59,13 @@ TEST(ImageEncode, PngColorRoundTripWithinOneLevel) {
   ASSERT_EQ(back.width, 16);
   ASSERT_EQ(back.height, 9);
   for (size_t i = 0; i < img.pixels.size(); ++i) {
-    EXPECT_NEAR(back.pixels[i], img.pixels[i], 0.5f / 255.0f + 1e-6f) << i;
+    const float expected = i % 4 == 3 ? img.pixels[i] : shading::linearToSrgb(img.pixels[i]);
+    EXPECT_NEAR(back.pixels[i], expected, 1.0f / 255.0f + 1e-6f) << i;
   }
+  // Mid-grey light is sRGB 188, not 128.
+  Image grey(1, 1, 4, 0.5f);
+  EXPECT_EQ(to8Bit(grey, pass::kColor), (std::vector<uint8_t>{188, 188, 188, 128}));
+  EXPECT_EQ(to8Bit(grey, pass::kDiff), (std::vector<uint8_t>{128, 128, 128, 128}));
   // Row 0 stays the top row.
   EXPECT_NEAR(back.at(0, 8, 1), 1.0f, 1e-6f);
   EXPECT_NEAR(back.at(0, 0, 1), 0.0f, 1e-6f);

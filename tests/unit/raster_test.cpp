@@ -453,7 +453,9 @@ TEST_F(RasterTest, WireframeDiffersFromColorOnlyAlongEdges) {
       double diagonal = segmentDistance(px[0], px[2], cx, cy);
       ASSERT_LE(std::min(d, diagonal), 1.0) << "pixel " << x << ", " << y << " is off the edges";
       onDiagonal += diagonal < d;
-      for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(wire.at(x, y, k), shading::kWireColor[k]);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(wire.at(x, y, k), shading::srgbToLinear(shading::kWireColor[k]), 0.6f / 255);
+      }
       EXPECT_EQ(wire.at(x, y, 3), 1.0f);
     }
   }
@@ -659,9 +661,11 @@ const PixelSegment* nearestSegment(const std::vector<PixelSegment>& segments, in
   return best;
 }
 
+// Overlay colours are sRGB; the pass holds them in linear light, through an 8-bit framebuffer.
 bool pixelHasColor(const Image& image, int x, int y, const Rgba& rgba) {
   for (int k = 0; k < 4; ++k) {
-    if (image.at(x, y, k) != rgba[k] / 255.0f) return false;
+    const float expected = k < 3 ? shading::srgbToLinear(rgba[k] / 255.0f) : rgba[k] / 255.0f;
+    if (std::abs(image.at(x, y, k) - expected) > 0.6f / 255) return false;
   }
   return true;
 }
@@ -863,7 +867,8 @@ TEST_F(RasterTest, AntialiasedOverlayLinesBlendIntoTheSurface) {
         double fromColor = 0, fromLine = 0;
         for (int c = 0; c < 3; ++c) {
           fromColor += std::fabs(lines.at(x, y, c) - color.at(x, y, c));
-          fromLine += std::fabs(lines.at(x, y, c) - overlay.colors[0][c] / 255.0);
+          fromLine +=
+              std::fabs(lines.at(x, y, c) - shading::srgbToLinear(overlay.colors[0][c] / 255.0f));
         }
         if (fromColor < 0.02) continue;
         (fromLine < 0.02 ? pure : blended) += 1;
