@@ -6,9 +6,11 @@
 
 #include <algorithm>
 
+#include "api/base64.h"
 #include "api/json_mesh_reader.h"
 #include "api/json_util.h"
 #include "api/request_parts.h"
+#include "formats/assimp_import.h"
 #include "formats/obj_reader.h"
 #include "render/mesh/content_hash.h"
 
@@ -45,6 +47,31 @@ BatchMesh meshFromObj(const std::string& name, const std::string& path, const st
   mesh.AddMember("data",
                  json::Value(text.c_str(), static_cast<rapidjson::SizeType>(text.size()), a), a);
   return described(obj.mesh, name, path, json::canonical(mesh));
+}
+
+BatchMesh meshFromFile(const std::string& name, const std::string& path, const std::string& bytes,
+                       const std::string& format, const std::optional<std::string>& scheme,
+                       const render::pipeline::JobLimits& limits) {
+  const std::optional<formats::ImportFormat> named = formats::importFormatNamed(format);
+  if (!named) json::fail("meshes", path + ": " + format + " is not a mesh file format limn reads");
+  formats::ImportOptions options;
+  if (scheme) options.scheme = schemeNamed(*scheme);
+  render::mesh::ControlMesh mesh;
+  try {
+    mesh = formats::importMesh(bytes, *named, options, limits.mesh).mesh;
+    render::mesh::validateMesh(mesh, limits.mesh);
+  } catch (const render::InputError& e) {
+    throw fromInputError(e);
+  }
+  rapidjson::Document wire(rapidjson::kObjectType);
+  auto& a = wire.GetAllocator();
+  wire.AddMember("format", json::Value(format.c_str(), a), a);
+  wire.AddMember("scheme", json::Value(render::mesh::schemeName(mesh.scheme), a), a);
+  const std::string encoded = encodeBase64(bytes);
+  wire.AddMember("dataBase64",
+                 json::Value(encoded.c_str(), static_cast<rapidjson::SizeType>(encoded.size()), a),
+                 a);
+  return described(mesh, name, path, json::canonical(wire));
 }
 
 BatchMesh meshFromJson(const std::string& name, const std::string& meshJson,

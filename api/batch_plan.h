@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -37,6 +38,13 @@ struct BatchMesh {
 // checked against `limits` as /v1/render would. Throws ApiError (422 naming the line...).
 BatchMesh meshFromObj(const std::string& name, const std::string& path, const std::string& text,
                       const std::string& scheme, const render::pipeline::JobLimits& limits);
+// A mesh file Assimp reads (`format`: "glb", "ply", ... as formats::importFormatNamed takes),
+// its scheme the given one, else chosen from its faces (formats/assimp_import.h); the compare
+// requests carry the file itself (dataBase64), so each worker reads it as /v1/render would.
+// Throws ApiError (422 naming the format and Assimp's message, 413 over a limit).
+BatchMesh meshFromFile(const std::string& name, const std::string& path, const std::string& bytes,
+                       const std::string& format, const std::optional<std::string>& scheme,
+                       const render::pipeline::JobLimits& limits);
 // A mesh given inline in a spec (either /v1/render form, or {"id"} of a mesh in `meshes`, which
 // the result carries inline: meshJson never refers to a cache).
 BatchMesh meshFromJson(const std::string& name, const std::string& meshJson,

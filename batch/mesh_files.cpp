@@ -3,10 +3,13 @@
 #include <glob.h>
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <set>
+
+#include "formats/assimp_import.h"
 
 namespace limn::batch {
 
@@ -16,6 +19,17 @@ namespace {
 
 bool isGlob(const std::string& pattern) {
   return pattern.find_first_of("*?[") != std::string::npos;
+}
+
+// OBJ (limn's reader) or a format Assimp reads ("glb", "ply", ...), by the file's extension;
+// "" for anything else.
+std::string meshFormatOf(const fs::path& file) {
+  std::string extension = file.extension().string();
+  if (!extension.empty()) extension.erase(0, 1);
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == "obj" || formats::importFormatNamed(extension)) return extension;
+  return "";
 }
 
 std::string readText(const fs::path& path) {
@@ -40,7 +54,7 @@ std::vector<fs::path> filesOf(const std::string& pattern, const fs::path& base,
     ::globfree(&found);
   } else if (fs::is_directory(full)) {
     for (const auto& entry : fs::directory_iterator(full)) {
-      if (entry.is_regular_file() && entry.path().extension() == ".obj") {
+      if (entry.is_regular_file() && !meshFormatOf(entry.path()).empty()) {
         files.push_back(entry.path());
       }
     }
@@ -108,11 +122,23 @@ std::vector<api::BatchMesh> loadMeshes(const std::vector<api::MeshEntry>& entrie
       continue;
     }
     for (const fs::path& file : filesOf(entry.pattern, base, warnings)) {
-      const std::string scheme = entry.scheme.value_or(guessScheme(file));
       // As the spec wrote it: relative patterns give paths relative to `base`.
       const fs::path shown = fs::path(entry.pattern).is_absolute()
                                  ? file.lexically_normal()
                                  : file.lexically_relative(base).lexically_normal();
+      const std::string format = meshFormatOf(file);
+      if (format != "obj" && !format.empty()) {
+        // Read in this process: `limn batch` on the user's own files (a server's jobs take
+        // no paths). The scheme follows the faces unless the spec names one.
+        try {
+          keep(api::meshFromFile(file.stem().string(), shown.string(), readText(file), format,
+                                 entry.scheme, limits));
+        } catch (const api::ApiError& e) {
+          throw MeshFileError(file.string() + ": " + e.message);
+        }
+        continue;
+      }
+      const std::string scheme = entry.scheme.value_or(guessScheme(file));
       try {
         keep(
             api::meshFromObj(file.stem().string(), shown.string(), readText(file), scheme, limits));

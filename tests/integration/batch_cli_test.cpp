@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -137,6 +138,44 @@ TEST_F(BatchCli, WritesResultsAndReportAndASecondRunComputesNothing) {
   EXPECT_NE(second.output.find("8 done already (skipped), 0 to compute"), std::string::npos)
       << second.output;
   EXPECT_EQ(slurp(dir_ / "results.jsonl"), before) << "nothing was computed again";
+}
+
+// A folder of mesh files of several formats: each is read (OFF's quads as Catmull-Clark, a
+// binary STL's triangles as Loop, welded), and its rows are computed like an OBJ's.
+TEST_F(BatchCli, AFolderOfMeshFilesOfOtherFormatsIsReadByExtension) {
+  const fs::path meshes = dir_ / "meshes";
+  fs::create_directories(meshes);
+  std::ofstream(meshes / "cube.off")
+      << "OFF\n8 6 0\n-1 -1 1\n1 -1 1\n-1 1 1\n1 1 1\n-1 1 -1\n1 1 -1\n-1 -1 -1\n1 -1 -1\n"
+         "4 0 1 3 2\n4 2 3 5 4\n4 4 5 7 6\n4 6 7 1 0\n4 1 7 5 3\n4 6 0 2 4\n";
+  const float corners[4][3] = {{1, 1, 1}, {-1, -1, 1}, {-1, 1, -1}, {1, -1, -1}};
+  const int faces[4][3] = {{0, 1, 3}, {0, 2, 1}, {0, 3, 2}, {1, 2, 3}};
+  std::string stl(80, ' ');
+  const uint32_t count = 4;
+  stl.append(reinterpret_cast<const char*>(&count), 4);
+  for (const auto& face : faces) {
+    const float normal[3] = {0, 0, 0};
+    stl.append(reinterpret_cast<const char*>(normal), sizeof normal);
+    for (int v : face) stl.append(reinterpret_cast<const char*>(corners[v]), sizeof corners[v]);
+    stl.append(2, '\0');
+  }
+  std::ofstream(meshes / "tetra.stl", std::ios::binary) << stl;
+  std::ofstream(meshes / "notes.txt") << "not a mesh";  // left out: not a mesh file's extension
+
+  CommandResult run = batch("--meshes '" + meshes.string() +
+                            "' --methods coarse,uniform:2 --views 1 --size 48" + out(dir_ / "out"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  std::set<std::string> names;
+  for (const std::string& line : lines(dir_ / "out" / "results.jsonl")) {
+    rapidjson::Document d;
+    d.Parse(line.c_str());
+    names.insert(d["mesh"].GetString());
+    EXPECT_TRUE(d.HasMember("metrics")) << line.substr(0, 300);
+    if (std::string(d["mesh"].GetString()) == "tetra") {
+      EXPECT_EQ(d["stats"]["controlVertices"].GetInt(), 4) << "the STL's corners welded";
+    }
+  }
+  EXPECT_EQ(names, (std::set<std::string>{"cube", "tetra"}));
 }
 
 TEST_F(BatchCli, ResumesAFileCutShort) {
