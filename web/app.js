@@ -114,6 +114,8 @@ function cameraFor(size) {
 
 function renderBody(mesh, size, compare) {
   const outputs = [mainOutput()];
+  // The reference panel shows colour: ask for it when the main picture is another output.
+  if (compare && outputs[0] !== "color") outputs.push("color");
   if (compare) outputs.push("diff");
   const background = $("background").value;
   if (state.scene) {
@@ -189,6 +191,8 @@ async function renderFull() {
   } catch (problem) {
     if (problem.name === "AbortError") return;
     showError(problem);
+    // What is shown no longer answers the settings: say so until a render succeeds.
+    document.body.classList.add("stale");
     if (problem instanceof ApiProblem && problem.status === 429) {
       setTimeout(renderFull, problem.retryAfter * 1000);
     }
@@ -202,6 +206,7 @@ async function renderFull() {
 }
 
 async function showAnswer(answer, compare) {
+  document.body.classList.remove("stale");
   const image = answer.images[mainOutput()] || answer.images.color;
   const shown = [showImage($("picture"), image)];
   $("gl-canvas").hidden = true;

@@ -384,6 +384,19 @@ describe("limn's page", () => {
     await set("#shading", "smooth");
   });
 
+  it("marks the pictures out of date after a failed request, until one succeeds", async () => {
+    await page.selectOption("#method", "uniform");
+    await page.selectOption("#shading", "normal-map");  // uniform cannot shade by a normal map
+    await page.waitForFunction(() => document.body.classList.contains("stale"), null,
+                               { timeout: 60_000 });
+    assert.ok(await page.isVisible("#stale-note"), "no note says the picture is out of date");
+    await shot("stale-after-error");
+    const renders = await set("#shading", "smooth");
+    await waitForRenders(renders + 1);
+    assert.ok(!(await page.evaluate(() => document.body.classList.contains("stale"))));
+    assert.ok(!(await page.isVisible("#stale-note")));
+  });
+
   it("compares with the reference: metrics, reference and diff", async () => {
     await page.selectOption("#example", "pawn");
     await page.waitForFunction(() => /Pawn/.test(document.querySelector("#mesh-info").textContent));
@@ -459,6 +472,14 @@ describe("limn's page", () => {
     const changed = await differingFraction("patchesShaded", "patchesByLevel");
     assert.ok(changed > 0.05, `the patch colours changed only ${(100 * changed).toFixed(2)}%`);
     await shot("patches-by-level", page.locator("#view"));
+    // Compared with the reference, the patch colours stay and the reference shows its colour
+    // (it has no patches: the page asks for colour beside them).
+    n = await set("#compare", true);
+    await waitForRenders(n + 1);
+    assert.ok(!(await page.isVisible("#page-error")), await page.textContent("#page-error"));
+    assert.ok(await inkFraction("#reference") > 0.05, "the reference is blank");
+    n = await set("#compare", false);
+    await waitForRenders(n + 1);
   });
 
   it("displaces the surface, and the reference with it", async () => {
