@@ -161,6 +161,7 @@ function showImage(img, image) {
 // call aborts the one in flight: only the latest camera and settings are worth finishing.
 async function renderFull() {
   if (!state.mesh) return;
+  offerWhatWorks();
   state.full?.abort();
   stopTurntable();
   const controller = (state.full = new AbortController());
@@ -207,6 +208,7 @@ async function renderFull() {
 
 async function showAnswer(answer, compare) {
   document.body.classList.remove("stale");
+  showWarnings(answer.warnings);
   const image = answer.images[mainOutput()] || answer.images.color;
   const shown = [showImage($("picture"), image)];
   $("gl-canvas").hidden = true;
@@ -769,6 +771,29 @@ function showMethodParams() {
   for (const group of document.querySelectorAll(".params")) {
     group.hidden = !group.dataset.for.split(" ").includes(method);
   }
+  offerWhatWorks();
+}
+
+// Options the server would refuse for the current method and scheme are not offered: normal-map
+// shading is drawn by coarse and silhouette only, the factored engine refines Catmull–Clark
+// only. A chosen option that stops working falls back to the default.
+function offerWhatWorks() {
+  const method = $("method").value, scheme = $("scheme").value;
+  const normalMap = $("shading").querySelector("option[value=normal-map]");
+  normalMap.disabled = !["coarse", "silhouette"].includes(method);
+  if (normalMap.disabled && $("shading").value === "normal-map") $("shading").value = "smooth";
+  const factored = $("engine").querySelector("option[value=factored]");
+  factored.disabled = scheme !== "catmull-clark";
+  if (factored.disabled && $("engine").value === "factored") $("engine").value = "auto";
+}
+
+// The server's notes about the last answer (ignored fields, a chord error raised, hits that
+// could not be refined), under the status line.
+function showWarnings(warnings) {
+  const list = warnings || [];
+  $("warnings").hidden = list.length === 0;
+  $("warnings").textContent = list.length === 1 ? `Note: ${list[0]}`
+                                                : `${list.length} notes: ${list.join(" · ")}`;
 }
 
 function applyLayout() {
@@ -788,6 +813,7 @@ function bindControls() {
     const file = $("upload").files[0];
     if (file) loadFile(file);
   });
+  $("scheme").addEventListener("change", offerWhatWorks);
   for (const id of ["scheme", "boundary", "crease-method"]) {
     $(id).addEventListener("change", () => {
       if (state.meshText !== null) useMesh(state.meshText, $("mesh-info").textContent.split(":")[0]);

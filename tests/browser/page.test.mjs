@@ -385,16 +385,38 @@ describe("limn's page", () => {
   });
 
   it("marks the pictures out of date after a failed request, until one succeeds", async () => {
-    await page.selectOption("#method", "uniform");
-    await page.selectOption("#shading", "normal-map");  // uniform cannot shade by a normal map
+    await page.selectOption("#method", "adaptive");
+    await waitForRenders((await page.evaluate(() => window.limnPage.renders)) + 1);
+    await set("#dicing-rate", 0);  // typed by hand: the server refuses a rate of 0
     await page.waitForFunction(() => document.body.classList.contains("stale"), null,
                                { timeout: 60_000 });
     assert.ok(await page.isVisible("#stale-note"), "no note says the picture is out of date");
+    assert.match(await page.textContent("#method-error"), /dicingRate/);
     await shot("stale-after-error");
-    const renders = await set("#shading", "smooth");
+    const renders = await set("#dicing-rate", 2);
     await waitForRenders(renders + 1);
     assert.ok(!(await page.evaluate(() => document.body.classList.contains("stale"))));
     assert.ok(!(await page.isVisible("#stale-note")));
+  });
+
+  it("offers only what works: normal-map shading for coarse and silhouette, factored for " +
+     "Catmull–Clark", async () => {
+    await page.selectOption("#method", "uniform");
+    assert.ok(await page.$eval("#shading option[value=normal-map]", (o) => o.disabled));
+    await page.selectOption("#method", "silhouette");
+    assert.ok(!(await page.$eval("#shading option[value=normal-map]", (o) => o.disabled)));
+    // (Each scheme change uploads the mesh again and renders it: wait for that.)
+    let renders = await page.evaluate(() => window.limnPage.renders);
+    await page.selectOption("#scheme", "loop");
+    await waitForRenders(renders + 1);
+    assert.ok(await page.$eval("#engine option[value=factored]", (o) => o.disabled));
+    renders = await page.evaluate(() => window.limnPage.renders);
+    await page.selectOption("#scheme", "catmull-clark");
+    await waitForRenders(renders + 1);
+    assert.ok(!(await page.$eval("#engine option[value=factored]", (o) => o.disabled)));
+    renders = await page.evaluate(() => window.limnPage.renders);
+    await page.selectOption("#method", "uniform");
+    await waitForRenders(renders + 1);
   });
 
   it("compares with the reference: metrics, reference and diff", async () => {
