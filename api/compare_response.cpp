@@ -30,12 +30,6 @@ bool anyImages(const render::pipeline::Outputs& o) {
   return o.color || o.mask || o.depth || o.normal || o.wireframe || o.contours || o.cage || o.diff;
 }
 
-void writeStrings(Writer& w, const std::vector<std::string>& strings) {
-  w.StartArray();
-  for (const std::string& s : strings) json::writeString(w, s);
-  w.EndArray();
-}
-
 // A row that could not be made: its error as /v1/render would have answered it.
 void writeRowError(Writer& w, const render::pipeline::RowError& error) {
   ApiError api = fromInputError(render::InputError(error.kind, error.subject, error.message));
@@ -94,7 +88,7 @@ void writeRow(Writer& w, const CompareRow& row, const CompareRequest& request,
     }
   }
   w.Key("warnings");
-  writeStrings(w, row.warnings);
+  json::writeStrings(w, row.warnings);
   w.EndObject();
 }
 
@@ -133,7 +127,7 @@ void writeReference(Writer& w, const CompareResult& result, const CompareRequest
                             warnings);
     }
     w.Key("warnings");
-    writeStrings(w, ref.warnings);
+    json::writeStrings(w, ref.warnings);
     w.EndObject();
   }
   w.EndArray();
@@ -191,7 +185,7 @@ std::string writeCompareResponse(const CompareResult& result, const CompareReque
   numberField(w, "totalMs", parseMs + result.totalMs + encodeMs);
   w.EndObject();
   w.Key("warnings");
-  writeStrings(w, warnings);
+  json::writeStrings(w, warnings);
   w.EndObject();
   return {buffer.GetString(), buffer.GetSize()};
 }

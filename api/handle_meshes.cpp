@@ -121,9 +121,7 @@ Answer handleMeshImport(std::string_view body, const render::pipeline::JobLimits
     w.Key("mesh");
     w.RawValue(meshJson.data(), meshJson.size(), rapidjson::kObjectType);
     w.Key("warnings");
-    w.StartArray();
-    for (const std::string& warning : warnings) json::writeString(w, warning);
-    w.EndArray();
+    json::writeStrings(w, warnings);
     w.EndObject();
     Answer answer;
     answer.body = {buffer.GetString(), buffer.GetSize()};
@@ -167,9 +165,7 @@ Answer storeImportedMesh(const Answer& imported, const render::pipeline::JobLimi
     w.Key("bytes");
     w.Uint64(bytes);
     w.Key("warnings");
-    w.StartArray();
-    for (const std::string& warning : warnings) json::writeString(w, warning);
-    w.EndArray();
+    json::writeStrings(w, warnings);
     w.EndObject();
     Answer answer;
     answer.body = {buffer.GetString(), buffer.GetSize()};

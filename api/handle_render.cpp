@@ -76,9 +76,7 @@ Answer handleRender(std::string_view body, const render::pipeline::JobLimits& li
     const Clock::time_point start = Clock::now();
     RenderRequest request = parseRenderRequest(body, limits, meshes);
     const std::optional<render::image::Format> image = acceptedImage(accept);
-    const render::pipeline::Outputs& o = request.job.outputs;
-    const int images = o.color + o.mask + o.depth + o.normal + o.wireframe + o.contours + o.cage +
-                       o.diff + o.patches;
+    const int images = request.job.outputs.count();
     const bool referenceImages =
         request.job.reference && request.job.method != render::pipeline::Method::Limit;
     if (image &&

@@ -46,9 +46,7 @@ std::string extrasJson(const render::pipeline::Approximation& a, const RenderReq
   w.Key("camera");
   response::writeCamera(w, a.camera);
   w.Key("warnings");
-  w.StartArray();
-  for (const std::string& warning : warnings) json::writeString(w, warning);
-  w.EndArray();
+  json::writeStrings(w, warnings);
   w.EndObject();
   return {buffer.GetString(), buffer.GetSize()};
 }

@@ -203,4 +203,10 @@ void writeString(Writer& writer, std::string_view text) {
   writer.String(text.data(), static_cast<rapidjson::SizeType>(text.size()));
 }
 
+void writeStrings(Writer& writer, const std::vector<std::string>& texts) {
+  writer.StartArray();
+  for (const std::string& text : texts) writeString(writer, text);
+  writer.EndArray();
+}
+
 }  // namespace limn::api::json

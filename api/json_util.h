@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "api/answer.h"
 #include "render/core/vec.h"
@@ -77,5 +78,7 @@ std::string canonical(const Value& value);
 void writeNumber(Writer& writer, double value);
 void writeKey(Writer& writer, const char* key);
 void writeString(Writer& writer, std::string_view text);
+// ["...", ...]: an answer's "warnings" and other lists of text.
+void writeStrings(Writer& writer, const std::vector<std::string>& texts);
 
 }  // namespace limn::api::json

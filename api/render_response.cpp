@@ -413,9 +413,7 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
   w.EndObject();
 
   w.Key("warnings");
-  w.StartArray();
-  for (const std::string& warning : warnings) json::writeString(w, warning);
-  w.EndArray();
+  json::writeStrings(w, warnings);
 
   w.Key("camera");
   writeCamera(w, result.camera);

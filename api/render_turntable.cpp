@@ -43,9 +43,7 @@ std::vector<render::CameraSpec> turntableCameras(const render::CameraSpec& camer
 
 // Every view's images are held until the answer is written: the same budget as frames.
 void checkPixels(const RenderRequest& request, const render::pipeline::JobLimits& limits) {
-  const render::pipeline::Outputs& o = request.job.outputs;
-  const size_t perView = o.color + o.mask + o.depth + o.normal + o.wireframe + o.contours + o.cage +
-                         o.diff + o.patches + request.turntable->animation;
+  const size_t perView = request.job.outputs.count() + request.turntable->animation;
   const size_t side =
       static_cast<size_t>(request.job.camera.width.value_or(render::kDefaultImageSide)) *
       request.job.camera.height.value_or(render::kDefaultImageSide);
@@ -187,9 +185,7 @@ std::string writeTurntable(const RenderRequest& request, const render::pipeline:
   w.Double(result.totalMs);
   w.EndObject();
   w.Key("warnings");
-  w.StartArray();
-  for (const std::string& warning : warnings) json::writeString(w, warning);
-  w.EndArray();
+  json::writeStrings(w, warnings);
   w.EndObject();
   return {buffer.GetString(), buffer.GetSize()};
 }

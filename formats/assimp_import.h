@@ -35,8 +35,8 @@ const char* importFormatName(ImportFormat format);
 // Every name importFormatNamed() takes, for messages and documentation.
 const std::vector<std::string>& importFormatNames();
 // model/gltf-binary, model/gltf+json, model/stl (and application/sla), model/ply (and
-// application/x-ply), model/vnd.collada+xml, application/x-3ds, application/x-fbx (and
-// application/octet-stream is not guessed: the caller names the format then).
+// application/x-ply), model/vnd.collada+xml, application/x-3ds, application/x-fbx, model/x-off.
+// application/octet-stream names no format: the caller gives it then (?format=).
 std::optional<ImportFormat> importFormatOfMediaType(std::string_view mediaType);
 
 struct ImportOptions {

@@ -188,24 +188,21 @@ void checkOff(std::string_view bytes, const MeshLimits& limits) {
   }
   const bool header = lines.size() == 2 && lines[0].size() == 1 && lines[0][0].size() >= 3 &&
                       lines[0][0].substr(lines[0][0].size() - 3) == "OFF";
-  const std::vector<std::string_view>& counts = lines.size() == 2 ? lines[1] : lines.emplace_back();
-  std::optional<uint64_t> vertices, faces;
-  if (counts.size() == 2 || counts.size() == 3) {
-    vertices = number(counts[0]);
-    faces = number(counts[1]);
-    if (counts.size() == 3 && !number(counts[2])) faces.reset();
-  }
-  if (!header || !vertices || !faces) {
+  const bool countLine = header && (lines[1].size() == 2 || lines[1].size() == 3) &&
+                         number(lines[1][0]) && number(lines[1][1]) &&
+                         (lines[1].size() == 2 || number(lines[1][2]));
+  if (!countLine) {
     throw InputError(InputError::Kind::InvalidMesh, "mesh.data",
                      "the off file does not start with an OFF line and then the line of counts "
                      "\"vertices faces [edges]\"");
   }
-  checkMeshCounts(*vertices, *faces, limits);
-  const uint64_t need = plus(times(*vertices, 6), times(*faces, 8));
+  const uint64_t vertices = *number(lines[1][0]), faces = *number(lines[1][1]);
+  checkMeshCounts(vertices, faces, limits);
+  const uint64_t need = plus(times(vertices, 6), times(faces, 8));
   if (need > bytes.size()) {
     dishonest(ImportFormat::Off,
-              std::to_string(*vertices) + " vertices and " + std::to_string(*faces) + " faces",
-              need, bytes.size());
+              std::to_string(vertices) + " vertices and " + std::to_string(faces) + " faces", need,
+              bytes.size());
   }
 }
 

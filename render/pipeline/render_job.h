@@ -81,6 +81,11 @@ struct Outputs {
   static constexpr int kDefaultAntialias = 4;
   // Where the colour-like outputs are not covered (background.h): transparent by default.
   Background background{};
+
+  // How many images are asked for.
+  int count() const {
+    return color + mask + depth + normal + wireframe + contours + cage + diff + patches;
+  }
 };
 
 // Limits on what one job may consume; the api layer checks requests against the same values.

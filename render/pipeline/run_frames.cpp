@@ -33,8 +33,7 @@ void checkFrames(const RenderJob& job, const JobLimits& limits) {
                      "frames: " + std::to_string(job.frames.size()) + " exceed limit maxFrames (" +
                          std::to_string(limits.maxFrames) + ")");
   }
-  const Outputs& o = job.outputs;
-  const size_t passes = o.color + o.mask + o.depth + o.normal + o.wireframe + o.cage + o.patches;
+  const size_t passes = static_cast<size_t>(job.outputs.count());
   const size_t pixels = job.frames.size() * passes *
                         static_cast<size_t>(job.camera.width.value_or(kDefaultImageSide)) *
                         static_cast<size_t>(job.camera.height.value_or(kDefaultImageSide));
