@@ -75,6 +75,19 @@ Sdc::Options schemeOptions(const mesh::ControlMesh& m) {
   return options;
 }
 
+bool isInteriorValenceTwo(const Far::TopologyLevel& base, int v) {
+  return base.GetVertexEdges(v).size() == 2 && base.GetVertexFaces(v).size() == 2 &&
+         !base.IsVertexBoundary(v) && !base.IsVertexNonManifold(v);
+}
+
+bool isNonManifoldWithSharpEdge(const Far::TopologyLevel& base, int v) {
+  if (!base.IsVertexNonManifold(v)) return false;
+  for (int e : base.GetVertexEdges(v)) {
+    if (base.GetEdgeSharpness(e) > 0) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 std::unique_ptr<Far::TopologyRefiner> createTopologyRefiner(const mesh::ControlMesh& m) {
@@ -181,19 +194,23 @@ std::unique_ptr<Far::TopologyRefiner> LimitSurface::createRefiner() const {
 
 const Far::TopologyLevel& LimitSurface::baseLevel() const { return refiner_->GetLevel(0); }
 
-// OpenSubdiv 3.5.0 (the Debian 12 version) reads uninitialised memory and may crash when Bfr
-// builds the irregular patch of a face around an interior vertex of valence 2 (fixed upstream
-// after 3.6). Those faces go to Far's adaptive patch table instead, which handles them.
+// OpenSubdiv 3.5.0 (the Debian 12 version) reads or writes outside its arrays when Bfr builds
+// the irregular patch of a face around
+//  - an interior vertex of valence 2: it reads uninitialised memory and may crash (fixed
+//    upstream after 3.6);
+//  - a non-manifold vertex with a sharp edge: the patch's local mesh of the manifold part
+//    around the vertex may lack the sharp edge (back-to-back faces), Bfr warns "Edge N
+//    specified to be sharp does not exist" and tags the edge at index -1, corrupting the heap.
+// Those faces go to Far's adaptive patch table instead, which handles both.
 std::vector<int> LimitSurface::facesBfrCannotEvaluate() const {
   std::vector<int> faces;
   if (mesh_.scheme == mesh::Scheme::Bilinear) return faces;  // bilinear has no irregular patches
   const Far::TopologyLevel& base = baseLevel();
   for (int v = 0; v < base.GetNumVertices(); ++v) {
-    Far::ConstIndexArray edges = base.GetVertexEdges(v);
-    if (edges.size() != 2 || base.IsVertexBoundary(v) || base.IsVertexNonManifold(v)) continue;
-    Far::ConstIndexArray incident = base.GetVertexFaces(v);
-    if (incident.size() != 2) continue;
-    faces.insert(faces.end(), incident.begin(), incident.end());
+    if (isInteriorValenceTwo(base, v) || isNonManifoldWithSharpEdge(base, v)) {
+      Far::ConstIndexArray incident = base.GetVertexFaces(v);
+      faces.insert(faces.end(), incident.begin(), incident.end());
+    }
   }
   return faces;
 }

@@ -1,5 +1,6 @@
 // LimitSurface against values known in closed form.
 #include <gtest/gtest.h>
+#include <opensubdiv/far/error.h>
 
 #include <algorithm>
 #include <atomic>
@@ -373,6 +374,45 @@ TEST(LimitSurface, EvaluatesFacesAroundInteriorValenceTwoVertices) {
   testing::addFace(pillow, {1, 2, 3, 4});
   testing::addFace(pillow, {0, 3, 2, 1});
   expectEvaluatesAroundValenceTwo(pillow, 3, "pillow");
+}
+
+// Creased triangles glued back to back (found by the engine fuzz target): every vertex is
+// non-manifold with a sharp edge. Bfr 3.5.0 builds such a face's patch from a local mesh that
+// lacks the sharp edge, warns "Edge N specified to be sharp does not exist" and then tags the
+// edge at index -1, corrupting the heap (a worker crash, now and then). The faces must be on
+// Far's patches, where no such warning is raised and the surface evaluates.
+std::vector<std::string> farWarnings;
+void recordFarWarning(const char* message) { farWarnings.emplace_back(message); }
+
+TEST(LimitSurface, CreasedNonManifoldVerticesAreOnFarPatchesNotBfrsBrokenPath) {
+  for (mesh::Scheme scheme : {mesh::Scheme::Loop, mesh::Scheme::CatmullClark}) {
+    mesh::ControlMesh m;
+    m.scheme = scheme;
+    m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}};
+    testing::addFace(m, {0, 2, 4});
+    testing::addFace(m, {1, 3, 4});
+    testing::addFace(m, {0, 2, 1});
+    testing::addFace(m, {0, 4, 2});  // back to back with the first
+    m.creases = {{4, 0, 9.9f}, {4, 2, 10.0f}};
+    farWarnings.clear();
+    OpenSubdiv::Far::SetWarningCallback(recordFarWarning);
+    LimitSurface surface(m);
+    for (int f = 0; f < m.faceCount(); ++f) {
+      EXPECT_TRUE(surface.onFarPatches(f)) << "face " << f;
+      if (!surface.hasLimit(f)) continue;
+      for (Vec2 uv : domainSamples(surface.parameterization(f))) {
+        LimitSample s = surface.evaluate(f, uv.x, uv.y);
+        ASSERT_TRUE(isFinite(s.position) && isFinite(s.normal)) << "face " << f;
+      }
+    }
+    OpenSubdiv::Far::SetWarningCallback(nullptr);
+    for (const std::string& w : farWarnings) ADD_FAILURE() << "OpenSubdiv warned: " << w;
+  }
+  // Sharp edges away from non-manifold vertices stay on Bfr.
+  mesh::ControlMesh cube = testing::cube();
+  cube.creases = {{0, 1, 2.0f}};
+  LimitSurface surface(cube);
+  for (int f = 0; f < cube.faceCount(); ++f) EXPECT_FALSE(surface.onFarPatches(f)) << f;
 }
 
 // The corpus shape made for this case (skipped without ../shared/corpus): nine shapes with
