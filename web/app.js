@@ -11,6 +11,15 @@ const DEFAULT_VIEW = { azimuthDeg: 30, elevationDeg: 20, distance: null };
 let firstView = DEFAULT_VIEW;  // the example's own view (examples.json "orbit"), else DEFAULT_VIEW
 const PREVIEW_DIVISOR = 4;  // drag previews render at a quarter of the size in each direction
 const LOCAL_MAX_TRIANGLES = 400_000;  // larger approximations are previewed by small renders
+const LOCAL_MAX_SIDE = 768;  // the local view's drawing buffer during a drag (scaled up to fit)
+// The server's default limits (docs/api.md, "Limits"; configs/default.json). The number
+// controls carry them as min/max, and a value outside them is refused here, at its control,
+// instead of being sent (the server would answer 400 or 413 naming the same limit).
+const LIMITS = { minDicingRate: 0.25, maxLevel: 6, maxIsolation: 8, maxImageSide: 4096,
+                 maxResolution: 512 };
+// Pictures are requested at the size they are shown, in device pixels, at most this long a side
+// (half of maxImageSide: a compare render stays within a second or two).
+const MAX_REQUEST_SIDE = Math.min(2048, LIMITS.maxImageSide);
 
 // What the browser tests (and a curious person in the console) can read.
 const page = (window.limnPage = {
@@ -21,6 +30,8 @@ const page = (window.limnPage = {
   firstPictureMs: null,  // performance.now() when the first full-size picture was shown
   dragToFullMs: null,    // from the last drag's end to its full-size picture
   lastAnswer: null,
+  get requestSize() { return requestSize(); },  // {width, height} of the next full picture
+  get layout() { return { ...layout }; },        // the panels' picture size in CSS pixels
   get busy() { return state.full !== null; },  // a full-size render is in flight
   // The local view holds the approximation the settings ask for (drags will draw it).
   get localReady() {
@@ -29,7 +40,7 @@ const page = (window.limnPage = {
   // The local view at the current camera, drawn now, as a PNG data URL (tests compare it with
   // the server's picture of the same camera).
   localSnapshot() {
-    state.glView.draw(orbitCamera(), fullSize(), {
+    state.glView.draw(orbitCamera(), requestSize(), {
       surface: $("draw-surface").checked, cage: $("draw-cage").checked,
       flat: $("shading").value === "flat", opaque: $("background").value !== "transparent",
     });
@@ -70,11 +81,16 @@ function clearErrors() {
 
 function showError(problem) {
   const slot = problem instanceof ApiProblem ? errorSlots[problem.control] : "page-error";
-  const text = problem instanceof ApiProblem ? `${problem.status}: ${problem.text}`
-                                             : `Could not reach limn: ${problem.message}`;
+  showMessage(slot, problem instanceof ApiProblem ? `${problem.status}: ${problem.text}`
+                                                 : `Could not reach limn: ${problem.message}`);
+}
+
+function showMessage(slot, text) {
   $(slot).textContent = text;
   $(slot).hidden = false;
-  $(slot).scrollIntoView({ block: "nearest" });
+  if (getComputedStyle($("controls")).visibility !== "hidden") {
+    $(slot).scrollIntoView({ block: "nearest" });
+  }
 }
 
 function setBusy(text) {
@@ -106,10 +122,24 @@ function mainOutput() {
   return "color";
 }
 
+// size: {width, height} in pixels.
 function cameraFor(size) {
   const orbit = { azimuthDeg: state.view.azimuthDeg, elevationDeg: state.view.elevationDeg };
   if (state.view.distance) orbit.distance = state.view.distance;
-  return { orbit, width: size, height: size };
+  const camera = { orbit, width: size.width, height: size.height };
+  if ($("orthographic").checked) {
+    camera.projection = "orthographic";
+    const height = orthoHeight();
+    if (height) camera.orthoHeight = height;
+  }
+  return camera;
+}
+
+// An orthographic view's height: the server's default (2.1 radii, the bounding sphere with a
+// margin) scaled as the orbit's distance is, so the wheel zooms it too; null for the default.
+function orthoHeight() {
+  if (!state.view.distance || !state.frame) return null;
+  return 2.1 * state.frame.radius * state.view.distance / framingRadii(state.frame.fovYDeg);
 }
 
 function renderBody(mesh, size, compare) {
@@ -142,9 +172,70 @@ function displacementOf(method) {
 // Where the page's renders go: meshes to /v1/render, implicit scenes to /v1/implicit.
 const renderPath = () => (state.scene ? "/v1/implicit" : "/v1/render");
 
-const fullSize = () => Number($("size").value);
 const comparing = () =>
   $("compare").checked && (state.scene !== null || $("method").value !== "limit");
+const sliderLayout = () =>
+  document.querySelector("input[name=compare-layout]:checked").value === "slider";
+
+// ---------------------------------------------------------------- layout
+
+// The size (CSS pixels) of each picture: the space there is beside the controls, for one
+// picture, or two (slider: the approximation and the difference), or three side by side or
+// stacked, whichever leaves them largest; on a narrow screen each takes the whole width.
+const layout = { w: 512, h: 512 };
+const PANEL_GAP = 14, CAPTION = 22, SLIDER = 26;
+
+function layoutPanels() {
+  document.body.classList.toggle("comparing", comparing());
+  const n = !comparing() ? 1 : sliderLayout() ? 2 : 3;
+  const panels = $("panels");
+  const width = panels.clientWidth - 2;  // the frames' borders
+  const top = panels.getBoundingClientRect().top + window.scrollY;
+  const height = window.innerHeight - top - 10;
+  const extra = CAPTION + (n === 2 ? SLIDER : 0);
+  let w, h;
+  if (n === 1) {
+    w = width;
+    h = Math.min(width, Math.max(height - extra, Math.min(width, 240)));
+  } else if (width < 600) {
+    w = h = width;
+  } else {
+    let best = 0;
+    for (let columns = 1; columns <= n; columns++) {
+      const rows = Math.ceil(n / columns);
+      const side = Math.min((width - (columns - 1) * PANEL_GAP) / columns,
+                            (height - rows * extra - (rows - 1) * PANEL_GAP) / rows);
+      best = Math.max(best, side);
+    }
+    w = h = Math.max(best, Math.min(width, 200));
+  }
+  layout.w = Math.max(64, Math.floor(w));
+  layout.h = Math.max(64, Math.floor(h));
+  panels.style.setProperty("--w", `${layout.w}px`);
+  panels.style.setProperty("--h", `${layout.h}px`);
+}
+
+// The full picture's size in pixels: the panel's size in device pixels ("as shown"), or the
+// chosen size along the longer side, within MAX_REQUEST_SIDE.
+function requestSize() {
+  const choice = $("size").value;
+  let w = layout.w - 2, h = layout.h - 2, cap = MAX_REQUEST_SIDE;  // inside the frame's border
+  if (choice === "auto") {
+    const dpr = window.devicePixelRatio || 1;
+    w *= dpr;
+    h *= dpr;
+  } else {
+    cap = Number(choice);
+    const scale = cap / Math.max(w, h);
+    w *= scale;
+    h *= scale;
+  }
+  const scale = Math.min(1, cap / Math.max(w, h));
+  return { width: Math.max(16, Math.round(w * scale)), height: Math.max(16, Math.round(h * scale)) };
+}
+
+const scaled = (size, factor) => ({ width: Math.max(16, Math.round(size.width * factor)),
+                                    height: Math.max(16, Math.round(size.height * factor)) });
 
 // ---------------------------------------------------------------- rendering
 
@@ -162,16 +253,21 @@ function showImage(img, image) {
 async function renderFull() {
   if (!state.mesh) return;
   offerWhatWorks();
+  layoutPanels();
+  applyLayout();
   state.full?.abort();
+  if (refuseInvalidInput()) return;
   stopTurntable();
   const controller = (state.full = new AbortController());
   const compare = comparing();
   const sentView = { ...state.view };
+  // A zoomed orthographic view's height needs the mesh's size, known from the first answer.
+  const orthoUnknown = $("orthographic").checked && state.view.distance && !orthoHeight();
   setBusy(compare ? "rendering and ray-casting the reference…" : "rendering…");
   const contours = $("draw-contours").checked ? loadContours(controller.signal) : null;
   try {
     const answer = await state.mesh.withId(
-        (mesh) => post(renderPath(), renderBody(mesh, fullSize(), compare),
+        (mesh) => post(renderPath(), renderBody(mesh, requestSize(), compare),
                        { signal: controller.signal }),
         controller.signal);
     if (controller.signal.aborted) return;
@@ -181,6 +277,10 @@ async function renderFull() {
     page.renders += 1;
     page.lastAnswer = answer;
     rememberFrame(answer.camera, sentView);
+    if (orthoUnknown) {  // now known: ask again (the first picture stays up meanwhile)
+      renderFull();
+      return;
+    }
     loadTessellation(answer.stats.triangles);
     const now = performance.now();
     if (page.firstPictureMs === null) page.firstPictureMs = now;
@@ -189,6 +289,7 @@ async function renderFull() {
       state.dragEndedAt = null;
     }
     $("view").dataset.renders = String(page.renders);
+    rememberInAddress();
   } catch (problem) {
     if (problem.name === "AbortError") return;
     showError(problem);
@@ -217,9 +318,9 @@ async function showAnswer(answer, compare) {
   const s = answer.stats, t = answer.timings;
   $("stats").textContent = `${s.triangles.toLocaleString("en")} triangles · ` +
       (state.scene ? `${s.closed ? "closed" : "not closed"} · ${s.implicit.primitives} primitives`
-                   : `${s.controlFaces} control faces`) + ` · ${t.totalMs.toFixed(0)} ms`;
+                   : `${s.controlFaces.toLocaleString("en")} control faces`) +
+      ` · ${t.totalMs.toFixed(0)} ms`;
   $("stats").dataset.triangles = String(s.triangles);
-  document.body.classList.toggle("comparing", compare);
   if (compare) {
     shown.push(showImage($("reference"), answer.reference.images.color));
     shown.push(showImage($("slider-reference"), answer.reference.images.color));
@@ -239,7 +340,7 @@ async function renderPreview() {
   }
   state.preview.busy = true;
   try {
-    const size = Math.max(64, Math.round(fullSize() / PREVIEW_DIVISOR));
+    const size = scaled(requestSize(), 1 / PREVIEW_DIVISOR);
     const answer = await state.mesh.withId(
         (mesh) => post(renderPath(), renderBody(mesh, size, false)));
     if ((state.dragging || state.full === null) && $("gl-canvas").hidden) {
@@ -276,12 +377,15 @@ function orbitCamera() {
   const az = (state.view.azimuthDeg * Math.PI) / 180, el = (state.view.elevationDeg * Math.PI) / 180;
   const dir = [Math.cos(el) * Math.sin(az), Math.sin(el), Math.cos(el) * Math.cos(az)];
   const distance = (state.view.distance || framingRadii(fovYDeg)) * radius;
+  const ortho = $("orthographic").checked;
   return {
     eye: target.map((t, i) => t + dir[i] * distance),
     target,
     up: [-Math.sin(el) * Math.sin(az), Math.cos(el), -Math.sin(el) * Math.cos(az)],
     fovYDeg,
-    near: Math.max(distance - 1.01 * radius, radius * 1e-3),
+    projection: ortho ? "orthographic" : "perspective",
+    orthoHeight: orthoHeight() || 2.1 * radius,
+    near: ortho ? distance - 1.01 * radius : Math.max(distance - 1.01 * radius, radius * 1e-3),
     far: distance + 1.01 * radius,
   };
 }
@@ -302,7 +406,7 @@ async function loadTessellation(triangles) {
   try {
     const glb = await state.mesh.withId(
         (mesh) => postBinary("/v1/tessellate",
-                             { mesh, camera: cameraFor(fullSize()), method: $("method").value,
+                             { mesh, camera: cameraFor(requestSize()), method: $("method").value,
                                params: methodParams() },
                              { signal: controller.signal, accept: "model/gltf-binary" }),
         controller.signal);
@@ -320,7 +424,8 @@ function drawLocal() {
   requestAnimationFrame(() => {
     frameRequested = false;
     if (!state.glView?.ready || !state.frame) return;
-    state.glView.draw(orbitCamera(), fullSize(), {
+    const full = requestSize();
+    state.glView.draw(orbitCamera(), scaled(full, Math.min(1, LOCAL_MAX_SIDE / Math.max(full.width, full.height))), {
       surface: $("draw-surface").checked, cage: $("draw-cage").checked,
       flat: $("shading").value === "flat", opaque: $("background").value !== "transparent",
     });
@@ -343,7 +448,7 @@ function previewMove() {
 async function loadContours(signal) {
   try {
     const svg = await state.mesh.withId(
-        (mesh) => post("/v1/silhouette", { mesh, camera: cameraFor(fullSize()), format: "svg" },
+        (mesh) => post("/v1/silhouette", { mesh, camera: cameraFor(requestSize()), format: "svg" },
                        { signal, accept: "image/svg+xml" }), signal);
     for (const id of ["contours-overlay", "reference-contours"]) {
       $(id).innerHTML = svg;
@@ -367,34 +472,65 @@ function formatNumber(x) {
   return a !== 0 && (a < 1e-3 || a >= 1e6) ? x.toExponential(2) : x.toPrecision(4);
 }
 
+// [good, suspicious]: a value on the good side of the first is coloured good, one past the
+// second suspicious (for "higher is better" rows the bounds decrease). Rough guides for a
+// picture of a few hundred pixels, not verdicts.
+const below = (good, suspicious) => (x) => (x <= good ? "good" : x > suspicious ? "suspicious" : "");
+const above = (good, suspicious) => (x) => (x >= good ? "good" : x < suspicious ? "suspicious" : "");
+
 function fillMetrics(answer) {
   const m = answer.metrics, s = answer.stats, t = answer.timings;
+  // [name, value, one-line explanation, judge]; a row with value null starts a table.
   const rows = [
     ["silhouette", null],
-    ["outline Hausdorff (px)", m.silhouette?.outlineHausdorffPx],
-    ["outline mean (px)", m.silhouette?.outlineMeanPx],
-    ["mask Hausdorff (px)", m.silhouette?.hausdorffPx],
-    ["IoU", m.silhouette?.iou],
-    ["mismatched pixels", m.silhouette?.mismatchPx],
+    ["outline Hausdorff (px)", m.silhouette?.outlineHausdorffPx,
+     "The farthest any point of the approximation's outline lies from the reference's outline " +
+     "(continuous curves, in pixels). Under 1 px the outlines look the same.", below(1, 2)],
+    ["outline mean (px)", m.silhouette?.outlineMeanPx,
+     "The average distance between the two outlines, in pixels.", below(0.5, 1)],
+    ["mask Hausdorff (px)", m.silhouette?.hausdorffPx,
+     "The same farthest distance measured on the covered-pixel masks (supersampled).", below(1, 2)],
+    ["IoU", m.silhouette?.iou,
+     "Covered pixels in both divided by covered pixels in either: 1 is the same coverage.",
+     above(0.995, 0.98)],
+    ["mismatched pixels", m.silhouette?.mismatchPx,
+     "Pixels covered by one of the two pictures but not the other."],
     ["image, depth, normals", null],
-    ["colour RMSE", m.image?.rmse],
-    ["PSNR (dB)", m.image?.psnr],
-    ["diff scale (top of ramp)", m.image?.diffScale],
-    ["depth max (rel.)", m.depth?.maxRel],
-    ["normal mean (deg)", m.normal?.meanDeg],
-    ["normal max (deg)", m.normal?.maxDeg],
-    ["geometry max dist (rel.)", m.geometry?.relMaxDist],
+    ["colour RMSE", m.image?.rmse,
+     "Root-mean-square colour difference (0..1 per channel) over the covered pixels.",
+     below(0.01, 0.04)],
+    ["PSNR (dB)", m.image?.psnr,
+     "Peak signal-to-noise ratio of the colour: above 40 dB differences are hard to see.",
+     above(40, 30)],
+    ["diff scale (top of ramp)", m.image?.diffScale,
+     "The largest colour difference of one pixel: the top (pale yellow) of the difference image."],
+    ["depth max (rel.)", m.depth?.maxRel,
+     "The largest depth difference at a pixel covered by both, relative to the depth.",
+     below(0.01, 0.05)],
+    ["normal mean (deg)", m.normal?.meanDeg,
+     "The average angle between the approximation's and the limit's normals over the pixels " +
+     "both cover: what shading errors come from.", below(1, 5)],
+    ["normal max (deg)", m.normal?.maxDeg,
+     "The largest normal angle at one pixel; large at a few pixels along the outline is common " +
+     "(one picture sees the front, the other the back), so read it with the mean."],
+    ["geometry max dist (rel.)", m.geometry?.relMaxDist,
+     "The largest distance from the approximation's vertices to the limit surface, relative to " +
+     "the bounding-box diagonal.", below(0.001, 0.01)],
     ["size", null],
-    ["triangles", s.triangles],
-    ["reference triangles", s.referenceTriangles],
+    ["triangles", s.triangles, "Triangles of the approximation."],
+    ["reference triangles", s.referenceTriangles, "Triangles of the reference's mesh, if any."],
     ["times (ms)", null],
-    ["surface", t.surfaceMs], ["approximation", t.approxMs], ["raster", t.rasterMs],
-    ["reference", t.referenceMs], ["metrics", t.metricsMs], ["encode", t.encodeMs],
-    ["total", t.totalMs],
+    ["surface", t.surfaceMs, "Building the limit surface (topology, patch tables)."],
+    ["approximation", t.approxMs, "Making the approximation's triangles."],
+    ["raster", t.rasterMs, "Drawing the pictures."],
+    ["reference", t.referenceMs, "Ray casting the exact limit surface."],
+    ["metrics", t.metricsMs, "Comparing the two."],
+    ["encode", t.encodeMs, "Writing the PNG images."],
+    ["total", t.totalMs, "The server's whole time for the request."],
   ];
   // One small table per group, side by side.
   const tables = [];
-  for (const [name, value] of rows) {
+  for (const [name, value, explanation, judge] of rows) {
     if (value === null) {
       const table = document.createElement("table");
       table.createCaption().textContent = name;
@@ -402,8 +538,14 @@ function fillMetrics(answer) {
       continue;
     }
     const tr = tables.at(-1).insertRow();
-    tr.insertCell().textContent = name;
-    tr.insertCell().textContent = formatNumber(value);
+    const label = tr.insertCell();
+    label.textContent = name;
+    label.title = explanation;
+    const cell = tr.insertCell();
+    cell.textContent = formatNumber(value);
+    cell.title = explanation;
+    const verdict = judge && typeof value === "number" ? judge(value) : "";
+    if (verdict) cell.className = verdict;
   }
   $("metrics").replaceChildren(...tables);
 }
@@ -535,6 +677,7 @@ async function useScene(request, label) {
   if (polygonizer.method) $("polygonizer").value = polygonizer.method;
   if (polygonizer.resolution) $("resolution").value = polygonizer.resolution;
   if (polygonizer.flatness !== undefined) $("flatness").value = polygonizer.flatness;
+  restoreAddress();
   $("draw-contours").checked = $("draw-cage").checked = false;
   showSourceControls();
   clearErrors();
@@ -577,7 +720,8 @@ async function uploadAndRender(uploaded, label) {
   setBusy("uploading the mesh…");
   try {
     const info = await uploaded.upload();
-    $("mesh-info").textContent = `${label}: ${info.vertices} vertices, ${info.faces} faces` +
+    $("mesh-info").textContent = `${label}: ${info.vertices.toLocaleString("en")} vertices, ` +
+        `${info.faces.toLocaleString("en")} faces` +
         (info.warnings.length ? ` (${info.warnings.length} warnings)` : "");
     $("mesh-info").title = info.warnings.join("\n");
   } catch (problem) {
@@ -606,6 +750,7 @@ async function loadExample(name) {
   firstView = { ...DEFAULT_VIEW, ...(example.orbit || {}) };
   state.view = { ...firstView };
   describeView();
+  restoreAddress();
   const text = await getText(`/examples/${encodeURIComponent(name)}`);
   await useMesh(text, example.title);
 }
@@ -660,7 +805,8 @@ async function playTurntable() {
   const frames = Number($("turntable-frames").value);
   setBusy(`rendering a turntable of ${frames} views…`);
   try {
-    const size = Math.min(fullSize(), 384);
+    const full = requestSize();
+    const size = scaled(full, Math.min(1, 384 / Math.max(full.width, full.height)));
     const answer = await state.mesh.withId(
         (mesh) => post("/v1/render", {
           ...renderBody(mesh, size, false),
@@ -697,43 +843,73 @@ function stopTurntable() {
 function describeView() {
   const v = state.view;
   $("camera-text").textContent = `azimuth ${v.azimuthDeg.toFixed(0)}°, elevation ` +
-      `${v.elevationDeg.toFixed(0)}°` + (v.distance ? `, distance ${v.distance.toFixed(2)} r` : "");
+      `${v.elevationDeg.toFixed(0)}°` + (v.distance ? `, distance ${v.distance.toFixed(2)} r` : "") +
+      ($("orthographic").checked ? ", orthographic" : "");
   $("view").dataset.azimuth = v.azimuthDeg.toFixed(1);
   $("view").dataset.elevation = v.elevationDeg.toFixed(1);
+  $("view").dataset.distance = v.distance ? v.distance.toFixed(3) : "";
 }
 
+// Starts a camera move: the full picture in flight is stale, and while it lasts the reference
+// and the difference (which answer the camera before) are dimmed.
+function beginMove() {
+  if (state.dragging) return;
+  state.dragging = true;
+  state.full?.abort();
+  $("view").classList.add("dragging");
+  document.body.classList.add("dragging");
+}
+
+function endMove() {
+  if (!state.dragging) return;  // a click, not a drag
+  state.dragging = false;
+  $("view").classList.remove("dragging");
+  document.body.classList.remove("dragging");
+  state.dragEndedAt = performance.now();
+  renderFull();
+}
+
+const defaultDistance = () => framingRadii(state.frame?.fovYDeg ?? 35);
+const clampDistance = (d) => Math.max(1.05, Math.min(40, d));
+
+// Mouse, pen and touch alike (pointer events): one pointer orbits, two pinch to zoom.
 function bindCamera() {
   const view = $("view");
-  let last = null;
+  const pointers = new Map();  // pointerId -> [x, y]
+  let pinch = null;            // {spread, distance} when the second finger went down
+  const spread = () => {
+    const [a, b] = [...pointers.values()];
+    return Math.hypot(a[0] - b[0], a[1] - b[1]) || 1;
+  };
   view.addEventListener("pointerdown", (event) => {
-    if (event.button !== 0) return;
-    view.setPointerCapture(event.pointerId);
-    last = [event.clientX, event.clientY];
+    if (event.pointerType === "mouse" && event.button !== 0) return;
+    try { view.setPointerCapture(event.pointerId); } catch { /* a synthetic pointer */ }
+    pointers.set(event.pointerId, [event.clientX, event.clientY]);
+    if (pointers.size === 2) {
+      pinch = { spread: spread(), distance: state.view.distance || defaultDistance() };
+    }
   });
   view.addEventListener("pointermove", (event) => {
+    const last = pointers.get(event.pointerId);
     if (!last) return;
     const dx = event.clientX - last[0], dy = event.clientY - last[1];
     if (dx === 0 && dy === 0) return;
-    last = [event.clientX, event.clientY];
-    if (!state.dragging) {  // the first move: a drag, and the full picture in flight is stale
-      state.dragging = true;
-      state.full?.abort();
-      view.classList.add("dragging");
-    }
+    pointers.set(event.pointerId, [event.clientX, event.clientY]);
+    beginMove();
     const v = state.view;
-    v.azimuthDeg = (((v.azimuthDeg - dx * 0.5) % 360) + 540) % 360 - 180;
-    v.elevationDeg = Math.max(-89, Math.min(89, v.elevationDeg + dy * 0.5));
+    if (pointers.size >= 2) {
+      if (pinch) v.distance = clampDistance(pinch.distance * pinch.spread / spread());
+    } else {
+      v.azimuthDeg = (((v.azimuthDeg - dx * 0.5) % 360) + 540) % 360 - 180;
+      v.elevationDeg = Math.max(-89, Math.min(89, v.elevationDeg + dy * 0.5));
+    }
     describeView();
     previewMove();
   });
-  const end = () => {
-    if (!last) return;
-    last = null;
-    if (!state.dragging) return;  // a click, not a drag
-    state.dragging = false;
-    view.classList.remove("dragging");
-    state.dragEndedAt = performance.now();
-    renderFull();
+  const end = (event) => {
+    if (!pointers.delete(event.pointerId)) return;
+    if (pointers.size < 2) pinch = null;
+    if (pointers.size === 0) endMove();
   };
   view.addEventListener("pointerup", end);
   view.addEventListener("pointercancel", end);
@@ -741,18 +917,13 @@ function bindCamera() {
   view.addEventListener("wheel", (event) => {
     event.preventDefault();
     const v = state.view;
-    const current = v.distance || 3.5;  // about the default framing at 35 degrees
-    v.distance = Math.max(1.05, Math.min(40, current * Math.pow(1.0015, event.deltaY)));
+    v.distance = clampDistance((v.distance || defaultDistance()) * Math.pow(1.0015, event.deltaY));
     describeView();
     previewMove();
     clearTimeout(wheelTimer);
     wheelTimer = setTimeout(renderFull, 250);
   }, { passive: false });
-  view.addEventListener("dblclick", () => {
-    state.view = { ...firstView };
-    describeView();
-    renderFull();
-  });
+  view.addEventListener("dblclick", resetView);
   // Dropping a file anywhere on the picture loads it.
   view.addEventListener("dragover", (event) => { event.preventDefault(); view.classList.add("drop"); });
   view.addEventListener("dragleave", () => view.classList.remove("drop"));
@@ -762,6 +933,33 @@ function bindCamera() {
     const file = event.dataTransfer.files[0];
     if (file) loadFile(file);
   });
+}
+
+function resetView() {
+  state.view = { ...firstView };
+  describeView();
+  renderFull();
+}
+
+// The standard views (azimuth and elevation, at the current distance) and "frame all" (the
+// default framing of the bounding sphere, at the current angles).
+const STANDARD_VIEWS = {
+  front: { azimuthDeg: 0, elevationDeg: 0 },
+  side: { azimuthDeg: 90, elevationDeg: 0 },
+  top: { azimuthDeg: 0, elevationDeg: 90 },
+  "three-quarter": { azimuthDeg: 45, elevationDeg: 30 },
+};
+
+function standardView(name) {
+  Object.assign(state.view, STANDARD_VIEWS[name]);
+  describeView();
+  renderFull();
+}
+
+function frameAll() {
+  state.view.distance = null;
+  describeView();
+  renderFull();
 }
 
 // ---------------------------------------------------------------- controls
@@ -785,6 +983,66 @@ function offerWhatWorks() {
   const factored = $("engine").querySelector("option[value=factored]");
   factored.disabled = scheme !== "catmull-clark";
   if (factored.disabled && $("engine").value === "factored") $("engine").value = "auto";
+  const scene = state.scene !== null;
+  const cage = $("draw-cage").checked && !scene && method !== "limit";
+  const patchColours = method === "patches" && $("show-patches").checked && !scene;
+  offerIf("draw-wireframe",
+          !$("draw-surface").checked ? "Wireframe: it is drawn on the surface; switch the surface on."
+          : cage ? "Wireframe: the server draws either the control cage or the wireframe over " +
+                   "the surface; switch the cage off."
+          : patchColours ? "Wireframe: not with the patch colours; untick colour by patch level."
+          : null);
+  offerIf("compare", method === "limit" && !scene
+      ? "Compare: the limit method is the exact reference itself; choose another method." : null);
+  const exportWhy = method === "limit" && !scene
+      ? "Mesh export: the limit is ray cast and has no triangles; choose another method."
+      : null;
+  for (const button of document.querySelectorAll("[data-mesh-format]")) {
+    button.disabled = Boolean(exportWhy) || (scene && button.dataset.meshFormat === "glb");
+    button.title = exportWhy || (button.disabled ? "implicit scenes are exported as PLY or OBJ" : "");
+  }
+  $("export-why").textContent = exportWhy || "";
+  $("export-why").hidden = !exportWhy;
+}
+
+// Disables a checkbox that cannot apply now (unticking it) and shows why under it; enables it
+// again when `reason` is null.
+function offerIf(id, reason) {
+  const input = $(id);
+  input.disabled = Boolean(reason);
+  if (reason) input.checked = false;
+  input.closest("label").title = reason || "";
+  $(`${id}-why`).textContent = reason || "";
+  $(`${id}-why`).hidden = !reason;
+}
+
+// A number typed by hand outside what the server takes (its limits, docs/api.md) is refused
+// here: the message goes under the control's section, the control is outlined, the pictures are
+// marked out of date, and nothing is sent. True when something was refused.
+function refuseInvalidInput() {
+  let refused = false;
+  for (const input of document.querySelectorAll("#controls input[type=number]")) {
+    const bad = !input.closest("[hidden]") && whatIsWrong(input);
+    input.setAttribute("aria-invalid", bad ? "true" : "false");
+    if (!bad || refused) continue;
+    refused = true;
+    const name = input.closest("label").firstChild.textContent.trim();
+    const slot = input.closest("section").querySelector(".error").id;
+    clearErrors();
+    showMessage(slot, `${name} ${bad}`);
+    document.body.classList.add("stale");
+    setBusy(null);
+  }
+  return refused;
+}
+
+function whatIsWrong(input) {
+  const value = input.valueAsNumber, limit = input.dataset.limit;
+  const why = limit ? ` (the server's limits.${limit})` : "";
+  if (!Number.isFinite(value)) return "must be a number.";
+  if (input.min !== "" && value < Number(input.min)) return `must be at least ${input.min}${why}.`;
+  if (input.max !== "" && value > Number(input.max)) return `must be at most ${input.max}${why}.`;
+  return null;
 }
 
 // The server's notes about the last answer (ignored fields, a chord error raised, hits that
@@ -797,12 +1055,14 @@ function showWarnings(warnings) {
 }
 
 function applyLayout() {
-  const slider = document.querySelector("input[name=compare-layout]:checked").value === "slider";
+  const slider = sliderLayout();
   document.body.classList.toggle("slider", slider);
   const on = slider && comparing() && document.body.classList.contains("comparing");
   $("slider").hidden = !on;
   $("slider-reference").hidden = !on;
+  $("slider-divider").hidden = !on;
   $("slider-reference").style.clipPath = `inset(0 0 0 ${$("slider").value}%)`;
+  $("slider-divider").style.left = `${$("slider").value}%`;
   $("approx-caption").textContent = on ? "approximation (left) | exact reference (right)"
                                        : "approximation";
 }
@@ -838,7 +1098,10 @@ function bindControls() {
     if ($("draw-contours").checked) loadContours(); else hideContours();
   });
   $("compare").addEventListener("change", async () => {
-    if (!comparing()) document.body.classList.remove("comparing");
+    if (comparing()) {  // the pictures of an earlier comparison are not shown as this one's
+      for (const id of ["reference", "slider-reference", "diff"]) $(id).removeAttribute("src");
+      $("metrics").replaceChildren();
+    }
     await renderFull();
     applyLayout();
   });
@@ -846,6 +1109,262 @@ function bindControls() {
     radio.addEventListener("change", applyLayout);
   }
   $("slider").addEventListener("input", applyLayout);
+  $("orthographic").addEventListener("change", () => { describeView(); renderFull(); });
+  for (const button of document.querySelectorAll("[data-view]")) {
+    button.addEventListener("click", () => standardView(button.dataset.view));
+  }
+  $("frame-all").addEventListener("click", frameAll);
+  $("download-png").addEventListener("click", downloadPictures);
+  $("download-json").addEventListener("click", () => downloadRecord("json"));
+  $("download-csv").addEventListener("click", () => downloadRecord("csv"));
+  for (const button of document.querySelectorAll("[data-mesh-format]")) {
+    button.addEventListener("click", () => downloadMesh(button.dataset.meshFormat));
+  }
+  $("copy-link").addEventListener("click", copyLink);
+}
+
+// ---------------------------------------------------------------- export and share
+
+function download(blob, name) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
+}
+
+// A short name for the files: the mesh and the method.
+function fileStem() {
+  const mesh = currentSource().value || "mesh";
+  const method = state.scene ? $("polygonizer").value : $("method").value;
+  return `limn-${mesh.replace(/[^A-Za-z0-9_.-]+/g, "_")}-${method}`;
+}
+
+// The pictures shown as one PNG: the approximation alone, or, comparing, the approximation,
+// the reference and the difference side by side (each at the size the server drew it).
+async function downloadPictures() {
+  const images = [$("picture")];
+  if (document.body.classList.contains("comparing")) images.push($("reference"), $("diff"));
+  const shown = images.filter((img) => img.naturalWidth > 0);
+  if (shown.length === 0) return;
+  const canvas = document.createElement("canvas");
+  canvas.width = shown.reduce((sum, img) => sum + img.naturalWidth, 0);
+  canvas.height = Math.max(...shown.map((img) => img.naturalHeight));
+  const ctx = canvas.getContext("2d");
+  let x = 0;
+  for (const img of shown) {
+    ctx.drawImage(img, x, 0);
+    x += img.naturalWidth;
+  }
+  const blob = await new Promise((resolve) => canvas.toBlob(resolve, "image/png"));
+  download(blob, `${fileStem()}${shown.length > 1 ? "-compare" : ""}.png`);
+}
+
+// What the last answer measured: its request's method and parameters, the resolved camera, the
+// metrics (comparing), the stats and the timings.
+function answerRecord() {
+  const a = page.lastAnswer;
+  if (!a) return null;
+  return { mesh: currentSource().value, method: state.scene ? "implicit" : $("method").value,
+           params: state.scene ? null : methodParams(), camera: a.camera, metrics: a.metrics || {},
+           stats: a.stats, timings: a.timings, warnings: a.warnings || [] };
+}
+
+// The record flattened into key,value rows ("metrics.silhouette.iou,0.998").
+function recordCsv(record) {
+  const rows = [["key", "value"]];
+  const walk = (value, key) => {
+    if (value === null || value === undefined) return;
+    if (Array.isArray(value)) {
+      value.forEach((v, i) => walk(v, `${key}[${i}]`));
+    } else if (typeof value === "object") {
+      for (const [k, v] of Object.entries(value)) walk(v, key ? `${key}.${k}` : k);
+    } else {
+      rows.push([key, String(value)]);
+    }
+  };
+  walk(record, "");
+  const quote = (x) => (/[",\n]/.test(x) ? `"${x.replace(/"/g, '""')}"` : x);
+  return rows.map((r) => r.map(quote).join(",")).join("\n") + "\n";
+}
+
+function downloadRecord(format) {
+  const record = answerRecord();
+  if (!record) return;
+  if (format === "json") {
+    download(new Blob([JSON.stringify(record, null, 2)], { type: "application/json" }),
+             `${fileStem()}-metrics.json`);
+  } else {
+    download(new Blob([recordCsv(record)], { type: "text/csv" }), `${fileStem()}-metrics.csv`);
+  }
+}
+
+// The approximation's triangles as a file: POST /v1/tessellate (an implicit scene: POST
+// /v1/implicit) with the Accept header of the format.
+const MESH_FORMATS = {
+  glb: { accept: "model/gltf-binary", type: "model/gltf-binary" },
+  ply: { accept: "application/x-ply", type: "application/x-ply" },
+  obj: { accept: "text/plain", type: "text/plain" },
+};
+
+async function downloadMesh(format) {
+  if (!state.mesh) return;
+  const { accept, type } = MESH_FORMATS[format];
+  setBusy(`exporting ${format.toUpperCase()}…`);
+  try {
+    const body = await state.mesh.withId((mesh) => {
+      const request = renderBody(mesh, requestSize(), false);
+      return postBinary(state.scene ? "/v1/implicit" : "/v1/tessellate", request, { accept });
+    });
+    download(new Blob([body], { type }), `${fileStem()}.${format}`);
+  } catch (problem) {
+    showError(problem);
+  } finally {
+    setBusy(null);
+  }
+}
+
+// The controls the address keeps, by parameter name; a control at its default is left out.
+const SHARED_CONTROLS = {
+  scheme: "scheme", boundary: "boundary", crease: "crease-method", method: "method",
+  level: "level", engine: "engine", rate: "dicing-rate", prate: "patch-dicing-rate",
+  isolation: "isolation", patches: "show-patches", disp: "displacement",
+  amp: "displacement-amplitude", waves: "displacement-frequency", contour: "contour-mode",
+  presub: "presubdivide", poly: "polygonizer", res: "resolution", flatness: "flatness",
+  surface: "draw-surface", cage: "draw-cage", wire: "draw-wireframe", contours: "draw-contours",
+  shading: "shading", size: "size", bg: "background", compare: "compare", ortho: "orthographic",
+};
+const controlDefaults = {};
+
+const controlValue = (el) => (el.type === "checkbox" ? (el.checked ? "1" : "0") : el.value);
+
+// What is shown: an example, an implicit scene, or an uploaded mesh by its server id.
+function currentSource() {
+  const picked = $("example").value;
+  if (picked.startsWith("scene:")) return { key: "scene", value: picked.slice(6) };
+  if (picked) return { key: "example", value: picked };
+  if (state.mesh?.id) return { key: "mesh", value: state.mesh.id };
+  return { key: null, value: null };
+}
+
+// The address of what is shown: the mesh, the controls that differ from their defaults and the
+// camera. It is kept in the address bar (replaceState after each picture), so reloading or
+// sharing it reopens the same state.
+function shareUrl() {
+  const q = new URLSearchParams();
+  const source = currentSource();
+  if (source.key) q.set(source.key, source.value);
+  if (source.key === "mesh") q.set("name", $("mesh-info").textContent.split(":")[0]);
+  for (const [name, id] of Object.entries(SHARED_CONTROLS)) {
+    const value = controlValue($(id));
+    if (value !== controlDefaults[name]) q.set(name, value);
+  }
+  if (sliderLayout()) q.set("layout", "slider");
+  const v = state.view;
+  q.set("az", v.azimuthDeg.toFixed(1));
+  q.set("el", v.elevationDeg.toFixed(1));
+  if (v.distance) q.set("d", v.distance.toFixed(3));
+  const preview = new URLSearchParams(location.search).get("preview");
+  if (preview) q.set("preview", preview);
+  return `${location.origin}${location.pathname}?${q}`;
+}
+
+function rememberInAddress() {
+  const url = shareUrl();
+  if (url !== location.href) history.replaceState(null, "", url);
+}
+
+// Sets the controls from an address's parameters; the camera, if it names one.
+function restoreControls(q) {
+  for (const [name, id] of Object.entries(SHARED_CONTROLS)) {
+    if (!q.has(name)) continue;
+    const el = $(id);
+    if (el.type === "checkbox") el.checked = q.get(name) === "1"; else el.value = q.get(name);
+  }
+  $("level-value").textContent = $("level").value;
+  if (q.get("layout") === "slider") document.querySelector("input[value=slider]").checked = true;
+  $("view").classList.toggle("transparent", $("background").value === "transparent");
+  if (!q.has("az")) return null;
+  const d = Number(q.get("d"));
+  return { azimuthDeg: Number(q.get("az")) || 0, elevationDeg: Number(q.get("el")) || 0,
+           distance: d > 0 ? d : null };
+}
+
+async function copyLink() {
+  const url = shareUrl();
+  history.replaceState(null, "", url);
+  try {
+    await navigator.clipboard.writeText(url);
+    $("share-note").textContent = "link copied";
+  } catch {
+    $("share-note").textContent = "the address bar holds the link";
+  }
+}
+
+// A mesh uploaded earlier, named by a shared address: its id is all the page has.
+class SharedMesh {
+  constructor(id) { this.id = id; }
+  withId(request) { return request({ id: this.id }); }
+}
+
+// ---------------------------------------------------------------- keys
+
+// Keys for what is changed most (listed in the page under "Mouse, touch and keys").
+function toggle(id) {
+  if ($(id).disabled) return;
+  $(id).checked = !$(id).checked;
+  $(id).dispatchEvent(new Event("change"));
+}
+
+function bindKeys() {
+  document.addEventListener("keydown", (event) => {
+    if (event.ctrlKey || event.metaKey || event.altKey) return;
+    if (event.target.closest("input, select, textarea, button")) return;
+    const key = event.key.toLowerCase();
+    const level = (step) => {
+      if ($("method").value !== "uniform" || state.scene) return;
+      const next = Math.max(0, Math.min(LIMITS.maxLevel, Number($("level").value) + step));
+      $("level").value = String(next);
+      $("level-value").textContent = $("level").value;
+      $("level").dispatchEvent(new Event("change"));
+    };
+    const actions = {
+      "+": () => level(1), "=": () => level(1), "-": () => level(-1), "_": () => level(-1),
+      w: () => toggle("draw-wireframe"), c: () => toggle("draw-cage"),
+      o: () => toggle("orthographic"), r: resetView, f: frameAll,
+      s: () => {
+        $("shading").value = $("shading").value === "smooth" ? "flat" : "smooth";
+        $("shading").dispatchEvent(new Event("change"));
+      },
+      1: () => standardView("front"), 2: () => standardView("side"), 3: () => standardView("top"),
+      4: () => standardView("three-quarter"),
+    };
+    if (!actions[key]) return;
+    event.preventDefault();
+    actions[key]();
+  });
+}
+
+// ---------------------------------------------------------------- window size
+
+// A resized window (or a turned phone) lays the panels out again, and asks for a new picture
+// when the size it would request has changed by more than a few pixels.
+function bindResize() {
+  let timer = null;
+  window.addEventListener("resize", () => {
+    const before = requestSize();
+    layoutPanels();
+    const after = requestSize();
+    if (Math.abs(after.width - before.width) + Math.abs(after.height - before.height) < 8) return;
+    clearTimeout(timer);
+    timer = setTimeout(renderFull, 300);
+  });
+  const drawer = (open) => document.body.classList.toggle("drawer-open", open);
+  $("open-controls").addEventListener("click", () => drawer(true));
+  $("close-controls").addEventListener("click", () => drawer(false));
+  document.addEventListener("keydown", (event) => { if (event.key === "Escape") drawer(false); });
 }
 
 async function start() {
@@ -856,10 +1375,14 @@ async function start() {
   } catch (error) {
     console.warn(`drag previews by small renders: ${error.message}`);
   }
+  for (const [name, id] of Object.entries(SHARED_CONTROLS)) controlDefaults[name] = controlValue($(id));
   showMethodParams();
   describeView();
   bindControls();
   bindCamera();
+  bindKeys();
+  bindResize();
+  layoutPanels();
   try {
     state.examples = await getJson("/examples");
   } catch (problem) {
@@ -874,9 +1397,32 @@ async function start() {
     console.warn("no implicit scenes:", problem.message);
   }
   $("example").add(new Option("(uploaded file)", ""));
-  const first = options.get("example") || "torus_creased";
+  // An address from "copy link" (or the address bar after any picture) restores its state.
+  state.restoring = options;
+  if (options.has("mesh")) {
+    $("example").value = "";
+    const id = options.get("mesh");
+    restoreAddress();
+    showSourceControls();
+    state.mesh = new SharedMesh(id);
+    $("mesh-info").textContent = `${options.get("name") || "uploaded mesh"}: mesh ${id} on the server`;
+    await renderFull();
+    return;
+  }
+  const first = options.has("scene") ? `scene:${options.get("scene")}`
+                                     : options.get("example") || "torus_creased";
   $("example").value = first;
   await loadExample(first);
+}
+
+// Applies the address's controls and camera once, after the example or scene set its own.
+function restoreAddress() {
+  if (!state.restoring) return;
+  const view = restoreControls(state.restoring);
+  state.restoring = null;
+  if (view) state.view = view;
+  describeView();
+  showMethodParams();
 }
 
 start();

@@ -104,7 +104,8 @@ const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const unit = (a) => { const l = Math.hypot(...a); return a.map((x) => x / l); };
 
-// Column-major projection * view for a perspective camera, as limn's Camera builds them.
+// Column-major projection * view for a perspective or orthographic camera, as limn's Camera
+// builds them.
 function viewProjection(camera, aspect) {
   const f = unit(sub(camera.target, camera.eye));
   const r = unit(cross(f, camera.up));
@@ -114,8 +115,12 @@ function viewProjection(camera, aspect) {
                 -dot(r, e), -dot(u, e), dot(f, e), 1];
   const t = 1 / Math.tan((camera.fovYDeg * Math.PI) / 360);
   const n = camera.near, fa = camera.far;
-  const proj = [t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, (fa + n) / (n - fa), -1,
-                0, 0, (2 * fa * n) / (n - fa), 0];
+  const h = camera.orthoHeight / 2;
+  const proj = camera.projection === "orthographic"
+      ? [1 / (h * aspect), 0, 0, 0, 0, 1 / h, 0, 0, 0, 0, 2 / (n - fa), 0,
+         0, 0, (fa + n) / (n - fa), 1]
+      : [t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, (fa + n) / (n - fa), -1,
+         0, 0, (2 * fa * n) / (n - fa), 0];
   const out = new Float32Array(16);
   for (let c = 0; c < 4; c++) {
     for (let row = 0; row < 4; row++) {
@@ -205,16 +210,18 @@ export class MeshView {
     if (this[vao]) this.gl.deleteVertexArray(this[vao]);
   }
 
-  // camera: {eye, target, up, fovYDeg, near, far}; what: {surface, cage, flat, opaque} (opaque:
-  // a white background, as the server's "background": "white").
+  // camera: {eye, target, up, fovYDeg, near, far, projection, orthoHeight}; size: {width,
+  // height} in pixels; what: {surface, cage, flat, opaque} (opaque: a white background, as the
+  // server's "background": "white").
   draw(camera, size, what) {
     const gl = this.gl, canvas = this.canvas;
-    if (canvas.width !== size) canvas.width = canvas.height = size;
-    gl.viewport(0, 0, size, size);
+    if (canvas.width !== size.width) canvas.width = size.width;
+    if (canvas.height !== size.height) canvas.height = size.height;
+    gl.viewport(0, 0, size.width, size.height);
     if (what.opaque) gl.clearColor(1, 1, 1, 1); else gl.clearColor(0, 0, 0, 0);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.enable(gl.DEPTH_TEST);
-    const viewProj = viewProjection(camera, 1);
+    const viewProj = viewProjection(camera, size.width / size.height);
     if (what.surface && this.ready) {
       gl.useProgram(this.surface);
       gl.uniformMatrix4fv(gl.getUniformLocation(this.surface, "uViewProj"), false, viewProj);

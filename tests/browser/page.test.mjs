@@ -206,7 +206,10 @@ describe("limn's page", () => {
     assert.ok(state.localFrames - localFrames >= 10, "the page drew few frames during the drag");
     await keepPixels("#picture", "afterDrag");
     assert.ok(await differingFraction("beforeDrag", "afterDrag") > 0.01, "the view did not turn");
-    assert.equal(await page.$eval("#picture", (img) => img.naturalWidth), 512);
+    // The picture is requested at the size it is shown.
+    const size = await page.evaluate(() => window.limnPage.requestSize);
+    assert.equal(await page.$eval("#picture", (img) => img.naturalWidth), size.width);
+    assert.equal(await page.$eval("#picture", (img) => img.naturalHeight), size.height);
     assert.ok(await page.locator("#gl-canvas").isHidden(), "the local view stays over the picture");
     // The local view and the server's picture of the same camera agree: the page's orbit is
     // the server's.
@@ -299,9 +302,10 @@ describe("limn's page", () => {
     }
     assert.ok(after > before, "the server finished a render nobody waited for");
     await page.uncheck("#compare");
-    await page.selectOption("#size", "512");
+    await page.selectOption("#size", "auto");
     await page.waitForFunction(() => document.querySelector("#progress").hidden &&
-                                     document.querySelector("#picture").naturalWidth === 512,
+                                     document.querySelector("#picture").naturalWidth ===
+                                     window.limnPage.requestSize.width,
                                null, { timeout: 60_000 });
   });
 
@@ -384,16 +388,44 @@ describe("limn's page", () => {
     await set("#shading", "smooth");
   });
 
-  it("marks the pictures out of date after a failed request, until one succeeds", async () => {
+  it("refuses a number outside the server's limits at its control, without a request",
+     async () => {
     await page.selectOption("#method", "adaptive");
     await waitForRenders((await page.evaluate(() => window.limnPage.renders)) + 1);
-    await set("#dicing-rate", 0);  // typed by hand: the server refuses a rate of 0
+    const sent = [];
+    const count = (request) => { if (request.url().includes("/v1/")) sent.push(request.url()); };
+    page.on("request", count);
+    await set("#dicing-rate", 0);  // typed by hand: below limits.minDicingRate
+    await page.waitForFunction(() => document.body.classList.contains("stale"));
+    assert.match(await page.textContent("#method-error"),
+                 /Dicing rate \(px\) must be at least 0\.25 \(the server's limits\.minDicingRate\)/);
+    assert.equal(await page.getAttribute("#dicing-rate", "aria-invalid"), "true");
+    assert.ok(await page.isVisible("#stale-note"), "no note says the picture is out of date");
+    await page.waitForTimeout(300);
+    page.off("request", count);
+    assert.deepEqual(sent, [], "the page sent a request with a rate of 0");
+    await shot("invalid-input");
+    const renders = await set("#dicing-rate", 2);
+    await waitForRenders(renders + 1);
+    assert.ok(!(await page.evaluate(() => document.body.classList.contains("stale"))));
+    assert.equal(await page.getAttribute("#dicing-rate", "aria-invalid"), "false");
+  });
+
+  it("marks the pictures out of date after a failed request, until one succeeds", async () => {
+    // A server error, forced: the next render answers 503 with limn's error body.
+    await page.route("**/v1/render", (route) => route.fulfill({
+      status: 503, contentType: "application/json",
+      body: JSON.stringify({ error: { code: "unavailable", message: "forced by the test" } }),
+    }), { times: 1 });
+    await set("#shading", "flat");
     await page.waitForFunction(() => document.body.classList.contains("stale"), null,
                                { timeout: 60_000 });
     assert.ok(await page.isVisible("#stale-note"), "no note says the picture is out of date");
-    assert.match(await page.textContent("#method-error"), /dicingRate/);
+    assert.match(await page.textContent("#page-error"), /503: forced by the test/);
+    const dimmed = await page.$eval("#picture", (img) => Number(getComputedStyle(img).opacity));
+    assert.ok(dimmed < 0.5, `the stale picture's opacity is ${dimmed}`);
     await shot("stale-after-error");
-    const renders = await set("#dicing-rate", 2);
+    const renders = await set("#shading", "smooth");
     await waitForRenders(renders + 1);
     assert.ok(!(await page.evaluate(() => document.body.classList.contains("stale"))));
     assert.ok(!(await page.isVisible("#stale-note")));
@@ -529,5 +561,282 @@ describe("limn's page", () => {
     await waitForRenders(n + 1);
     assert.ok(!(await page.isVisible("#displacement")), "the displacement control stayed");
     await set("#displacement", "none");
+  });
+
+  // ------------------------------------------------------------ layout, touch, honest controls
+
+  // Every picture shown, with its box, its panel's box and its pixel size.
+  const pictureBoxes = (p) => p.$$eval("#picture, #reference, #diff", (imgs) => imgs
+      .filter((img) => img.offsetParent !== null && getComputedStyle(img).display !== "none")
+      .map((img) => {
+        const r = img.getBoundingClientRect();
+        const panel = img.closest("figure").getBoundingClientRect();
+        return { id: img.id, left: r.left, right: r.right, top: r.top, bottom: r.bottom,
+                 width: r.width, panel: panel.width, natural: img.naturalWidth,
+                 naturalHeight: img.naturalHeight, height: r.height };
+      }));
+
+  for (const [width, height] of [[390, 844], [1024, 768], [1920, 1080]]) {
+    it(`fits a ${width}x${height} window: nothing off screen, pictures as wide as their panels`,
+       async () => {
+      const other = await browser.newPage({ viewport: { width, height } });
+      other.on("pageerror", (error) => console.log(`page error: ${error.message}`));
+      for (const compare of [false, true]) {
+        await other.goto(`${baseUrl}/?example=cube&level=1${compare ? "&compare=1" : ""}`);
+        await other.waitForFunction(() => window.limnPage.renders >= 1 && !window.limnPage.busy,
+                                    null, { timeout: 120_000 });
+        const shown = await other.evaluate(() => ({
+          scrollWidth: document.documentElement.scrollWidth, dpr: devicePixelRatio,
+        }));
+        assert.ok(shown.scrollWidth <= width, `the page is ${shown.scrollWidth} px wide`);
+        const boxes = await pictureBoxes(other);
+        assert.equal(boxes.length, compare ? 3 : 1, JSON.stringify(boxes));
+        for (const b of boxes) {
+          assert.ok(b.left >= 0 && b.right <= width + 0.5, `${b.id} off screen: ${JSON.stringify(b)}`);
+          assert.ok(b.width >= 0.8 * b.panel, `${b.id} is ${b.width} px of a ${b.panel} px panel`);
+          // A phone scrolls to the compare panels below the picture; a desktop shows them all.
+          if (width > 800 || b.id === "picture") {
+            assert.ok(b.top >= 0 && b.bottom <= height, `${b.id} below the fold: ${JSON.stringify(b)}`);
+          }
+          // Requested at the size it is shown, in device pixels.
+          assert.ok(Math.abs(b.natural - b.width * shown.dpr) <= 1,
+                    `${b.id}: ${b.natural} px drawn for ${b.width} px shown`);
+        }
+        if (!compare) {  // the picture takes the width beside the controls (all of it on a phone)
+          const room = width > 800 ? width - 290 - 36 : width - 24;
+          assert.ok(boxes[0].width >= 0.95 * room, `the picture is ${boxes[0].width} px of ${room}`);
+        }
+        await other.screenshot({ path: path.join(artifacts, `layout-${width}x${height}${compare ? "-compare" : ""}.png`) });
+      }
+      if (width <= 800) {
+        // The controls are a drawer, opened from the status line.
+        assert.ok(!(await other.isVisible("#method")), "the controls cover the picture");
+        await other.click("#open-controls");
+        await other.locator("#method").waitFor({ state: "visible" });
+        await other.waitForTimeout(400);  // the drawer slides in
+        const box = await other.locator("#controls").boundingBox();
+        assert.ok(box.x >= -0.5 && box.x + box.width <= width + 0.5, JSON.stringify(box));
+        await other.screenshot({ path: path.join(artifacts, `layout-${width}x${height}-drawer.png`) });
+        await other.click("#close-controls");
+        await other.locator("#method").waitFor({ state: "hidden" });
+      } else {
+        // During a drag the reference and the difference (the camera before) are dimmed.
+        const box = await other.locator("#view").boundingBox();
+        await other.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+        await other.mouse.down();
+        await other.mouse.move(box.x + box.width / 2 + 40, box.y + box.height / 2);
+        const opacity = await other.$eval("#reference", (img) => Number(getComputedStyle(img).opacity));
+        assert.ok(await other.isVisible("#reference-panel .drag-note"));
+        await other.mouse.up();
+        assert.ok(opacity < 0.5, `the reference's opacity during a drag is ${opacity}`);
+      }
+      await other.close();
+    });
+  }
+
+  it("orbits with one finger and zooms with two (touch pointer events)", async () => {
+    const other = await browser.newPage({ viewport: { width: 390, height: 844 }, hasTouch: true,
+                                          isMobile: true });
+    await other.goto(`${baseUrl}/?example=cube`);
+    await other.waitForFunction(() => window.limnPage.renders >= 1 && !window.limnPage.busy);
+    const before = await other.$eval("#view", (el) => ({ ...el.dataset }));
+    // Touch pointers as a browser sends them: pointerdown, pointermove..., pointerup.
+    const touch = (type, id, x, y) => other.$eval("#view", (view, [type, id, x, y]) => {
+      const r = view.getBoundingClientRect();
+      view.dispatchEvent(new PointerEvent(type, { pointerId: id, pointerType: "touch", isPrimary: id === 1,
+                                                  clientX: r.left + x, clientY: r.top + y, bubbles: true }));
+    }, [type, id, x, y]);
+    await touch("pointerdown", 1, 100, 150);
+    for (let i = 1; i <= 10; i++) await touch("pointermove", 1, 100 + 8 * i, 150);
+    await touch("pointerup", 1, 180, 150);
+    await other.waitForFunction(() => window.limnPage.renders >= 2 && !window.limnPage.busy);
+    const orbited = await other.$eval("#view", (el) => ({ ...el.dataset }));
+    assert.ok(Math.abs(Number(orbited.azimuth) - Number(before.azimuth)) >= 30,
+              `azimuth ${before.azimuth} -> ${orbited.azimuth}`);
+    // Two fingers spreading from 100 to 200 px apart: half the distance.
+    await touch("pointerdown", 1, 125, 150);
+    await touch("pointerdown", 2, 225, 150);
+    for (let i = 1; i <= 10; i++) {
+      await touch("pointermove", 1, 125 - 5 * i, 150);
+      await touch("pointermove", 2, 225 + 5 * i, 150);
+    }
+    await touch("pointerup", 1, 75, 150);
+    await touch("pointerup", 2, 275, 150);
+    await other.waitForFunction(() => window.limnPage.renders >= 3 && !window.limnPage.busy);
+    const pinched = await other.$eval("#view", (el) => ({ ...el.dataset }));
+    const framing = 1.05 / Math.sin((35 * Math.PI) / 360);
+    assert.ok(Math.abs(Number(pinched.distance) - framing / 2) < 0.05,
+              `distance after the pinch: ${pinched.distance} (default ${framing.toFixed(3)})`);
+    assert.equal(pinched.azimuth, orbited.azimuth, "the pinch turned the view");
+    await other.close();
+  });
+
+  it("disables what cannot apply, and says why", async () => {
+    let n = await set("#draw-cage", true);
+    await waitForRenders(n + 1);
+    assert.ok(await page.$eval("#draw-wireframe", (el) => el.disabled));
+    assert.match(await page.textContent("#draw-wireframe-why"), /either the control cage or the wireframe/);
+    assert.ok(await page.isVisible("#draw-wireframe-why"));
+    n = await set("#draw-surface", false);
+    await waitForRenders(n + 1);
+    assert.match(await page.textContent("#draw-wireframe-why"), /switch the surface on/);
+    n = await set("#draw-surface", true);
+    await waitForRenders(n + 1);
+    n = await set("#draw-cage", false);
+    await waitForRenders(n + 1);
+    assert.ok(!(await page.$eval("#draw-wireframe", (el) => el.disabled)));
+    assert.ok(!(await page.isVisible("#draw-wireframe-why")));
+    // The limit method is the reference: nothing to compare, no triangles to export.
+    n = await set("#method", "limit");
+    await waitForRenders(n + 1);
+    assert.ok(await page.$eval("#compare", (el) => el.disabled));
+    assert.match(await page.textContent("#compare-why"), /limit method is the exact reference/);
+    assert.ok(await page.$eval("[data-mesh-format=glb]", (el) => el.disabled));
+    assert.match(await page.textContent("#export-why"), /ray cast/);
+    await shot("disabled-with-reason");
+    n = await set("#method", "uniform");
+    await waitForRenders(n + 1);
+    assert.ok(!(await page.$eval("#compare", (el) => el.disabled)));
+  });
+
+  it("takes keys for the level, wireframe, shading, views and reset, listed in the page", async () => {
+    const keys = await page.textContent("#shortcuts");
+    for (const word of ["wireframe", "shading", "reset", "iteration", "orthographic"]) {
+      assert.ok(keys.includes(word), `the shortcuts do not mention ${word}`);
+    }
+    await page.locator("#view").focus();
+    const level = Number(await page.$eval("#level", (el) => el.value));
+    let n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("+");
+    await waitForRenders(n + 1);
+    assert.equal(Number(await page.$eval("#level", (el) => el.value)), Math.min(6, level + 1));
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("-");
+    await waitForRenders(n + 1);
+    assert.equal(Number(await page.$eval("#level", (el) => el.value)), level);
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("w");
+    await waitForRenders(n + 1);
+    assert.ok(await page.$eval("#draw-wireframe", (el) => el.checked));
+    assert.ok(await page.evaluate(() => "wireframe" in window.limnPage.lastAnswer.images));
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("w");
+    await waitForRenders(n + 1);
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("s");
+    await waitForRenders(n + 1);
+    assert.equal(await page.$eval("#shading", (el) => el.value), "flat");
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("s");
+    await waitForRenders(n + 1);
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("3");  // top
+    await waitForRenders(n + 1);
+    assert.equal(await page.$eval("#view", (el) => el.dataset.elevation), "90.0");
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.keyboard.press("r");
+    await waitForRenders(n + 1);
+    assert.notEqual(await page.$eval("#view", (el) => el.dataset.elevation), "90.0");
+  });
+
+  it("keeps its state in the address: the shared URL reopens mesh, method, settings and camera",
+     async () => {
+    let n = await set("#level", 1);
+    await waitForRenders(n + 1);
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.click("[data-view=side]");
+    await waitForRenders(n + 1);
+    n = await set("#orthographic", true);
+    await waitForRenders(n + 1);
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.mouse.move(0, 0);
+    const box = await page.locator("#view").boundingBox();
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.wheel(0, -200);  // zoom in
+    await waitForRenders(n + 1);
+    n = await set("#shading", "flat");
+    await waitForRenders(n + 1);
+    await page.click("#copy-link");
+    const url = await page.evaluate(() => location.href);
+    assert.match(url, /example=cube/);
+    const want = await page.evaluate(() => ({
+      camera: window.limnPage.lastAnswer.camera, level: document.querySelector("#level").value,
+      shading: document.querySelector("#shading").value,
+      ortho: document.querySelector("#orthographic").checked,
+      method: document.querySelector("#method").value,
+    }));
+    assert.equal(want.camera.projection, "orthographic");
+    const other = await browser.newPage({ viewport: { width: 1240, height: 800 } });
+    await other.goto(url);
+    await other.waitForFunction(() => window.limnPage.renders >= 1 && !window.limnPage.busy);
+    const got = await other.evaluate(() => ({
+      camera: window.limnPage.lastAnswer.camera, level: document.querySelector("#level").value,
+      shading: document.querySelector("#shading").value,
+      ortho: document.querySelector("#orthographic").checked,
+      method: document.querySelector("#method").value,
+    }));
+    for (const key of ["level", "shading", "ortho", "method"]) assert.equal(got[key], want[key], key);
+    assert.equal(got.camera.projection, "orthographic");
+    assert.ok(Math.abs(got.camera.orthoHeight - want.camera.orthoHeight) < 1e-3 * want.camera.orthoHeight,
+              `orthoHeight ${got.camera.orthoHeight} vs ${want.camera.orthoHeight}`);
+    for (let k = 0; k < 3; k++) {
+      assert.ok(Math.abs(got.camera.eye[k] - want.camera.eye[k]) < 1e-2, `eye ${got.camera.eye} vs ${want.camera.eye}`);
+    }
+    await other.close();
+    // An uploaded mesh is named by its id on the server.
+    const off = "OFF\n4 4 0\n1 1 1\n-1 -1 1\n-1 1 -1\n1 -1 -1\n3 0 1 3\n3 0 2 1\n3 0 3 2\n3 1 2 3\n";
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.setInputFiles("#upload", { name: "tetra.off", mimeType: "application/octet-stream",
+                                          buffer: Buffer.from(off) });
+    await waitForRenders(n + 1);
+    const uploaded = await page.evaluate(() => location.href);
+    assert.match(uploaded, /mesh=[0-9a-f]{32}/);
+    const third = await browser.newPage({ viewport: { width: 1240, height: 800 } });
+    await third.goto(uploaded);
+    await third.waitForFunction(() => window.limnPage.renders >= 1 && !window.limnPage.busy);
+    assert.equal(await third.evaluate(() => window.limnPage.lastAnswer.stats.controlFaces), 4);
+    assert.match(await third.textContent("#mesh-info"), /tetra\.off/);
+    await third.close();
+    n = await set("#orthographic", false);
+    await waitForRenders(n + 1);
+    n = await page.evaluate(() => window.limnPage.renders);
+    await page.selectOption("#example", "cube");
+    await waitForRenders(n + 1);
+  });
+
+  it("downloads the pictures, the metrics and the approximation as valid files", async () => {
+    const { readFileSync } = await import("node:fs");
+    const fetchDownload = async (selector) => {
+      const [download] = await Promise.all([page.waitForEvent("download", { timeout: 60_000 }),
+                                            page.click(selector)]);
+      return { name: download.suggestedFilename(), bytes: readFileSync(await download.path()) };
+    };
+    const n = await set("#compare", true);
+    await waitForRenders(n + 1);
+    const png = await fetchDownload("#download-png");
+    assert.match(png.name, /^limn-[\w.-]+-uniform-compare\.png$/);
+    assert.deepEqual([...png.bytes.subarray(0, 8)], [137, 80, 78, 71, 13, 10, 26, 10]);
+    // Three pictures side by side.
+    const size = await page.evaluate(() => window.limnPage.requestSize);
+    assert.equal(png.bytes.readUInt32BE(16), 3 * size.width);
+    const json = JSON.parse((await fetchDownload("#download-json")).bytes.toString());
+    assert.ok(json.metrics.silhouette.iou > 0 && json.metrics.silhouette.iou <= 1,
+              JSON.stringify(json.metrics));
+    assert.equal(json.method, "uniform");
+    const csv = (await fetchDownload("#download-csv")).bytes.toString().trim().split("\n");
+    assert.equal(csv[0], "key,value");
+    const iou = csv.find((line) => line.startsWith("metrics.silhouette.iou,"));
+    assert.ok(iou && Number(iou.split(",")[1]) === json.metrics.silhouette.iou, iou);
+    const glb = await fetchDownload("[data-mesh-format=glb]");
+    assert.equal(glb.bytes.subarray(0, 4).toString(), "glTF");
+    assert.equal(glb.bytes.readUInt32LE(4), 2);
+    assert.equal(glb.bytes.readUInt32LE(8), glb.bytes.length);
+    const ply = await fetchDownload("[data-mesh-format=ply]");
+    assert.match(ply.bytes.subarray(0, 40).toString("latin1"), /^ply\n/);
+    const obj = (await fetchDownload("[data-mesh-format=obj]")).bytes.toString();
+    const triangles = obj.split("\n").filter((line) => line.startsWith("f ")).length;
+    assert.equal(triangles, json.stats.triangles);
+    const m = await set("#compare", false);
+    await waitForRenders(m + 1);
   });
 });
