@@ -324,8 +324,9 @@ async function showAnswer(answer, compare) {
   if (compare) {
     shown.push(showImage($("reference"), answer.reference.images.color));
     shown.push(showImage($("slider-reference"), answer.reference.images.color));
-    if (answer.images.diff) shown.push(showImage($("diff"), answer.images.diff));
-    $("diff-scale").textContent = formatNumber(answer.metrics.image?.diffScale);
+    state.diff = answer.images.diff ? { image: answer.images.diff, scale: answer.metrics.image?.diffScale }
+                                    : null;
+    if (state.diff) shown.push(showDiff());
     fillMetrics(answer);
   }
   await Promise.all(shown);
@@ -461,6 +462,90 @@ async function loadContours(signal) {
 
 function hideContours() {
   for (const id of ["contours-overlay", "reference-contours"]) $(id).hidden = true;
+}
+
+// ---------------------------------------------------------------- the difference image
+
+// The server's difference image is linear from 0 (black) to its top, the largest difference of
+// any pixel (metrics.image.diffScale, pale yellow): one bad pixel leaves the rest dark. The page
+// can redraw it with another top — a percentile of the covered pixels' differences (brighter
+// ones clamped) — or on a logarithmic scale, reading each pixel's difference back from the
+// ramp's colour (the ramp of render/metrics/image_metrics.cpp, written as bytes without sRGB).
+const HEAT_STOPS = [[0.00, 0.00, 0.02], [0.34, 0.06, 0.43], [0.73, 0.21, 0.33], [0.98, 0.55, 0.04],
+                    [0.99, 1.00, 0.64]];
+
+function heatRamp(t) {
+  const x = Math.min(1, Math.max(0, t)) * 4, i = Math.min(Math.floor(x), 3), f = x - i;
+  return HEAT_STOPS[i].map((c, k) => c + f * (HEAT_STOPS[i + 1][k] - c));
+}
+
+const HEAT_TABLE = Array.from({ length: 1021 }, (_, k) => heatRamp(k / 1020).map((c) => c * 255));
+
+// The ramp position (0..1) of an 8-bit colour: the nearest of the table's colours.
+function rampPosition(r, g, b, cache) {
+  const key = (r << 16) | (g << 8) | b;
+  let t = cache.get(key);
+  if (t !== undefined) return t;
+  let best = Infinity;
+  HEAT_TABLE.forEach(([R, G, B], k) => {
+    const d = (R - r) ** 2 + (G - g) ** 2 + (B - b) ** 2;
+    if (d < best) { best = d; t = k / 1020; }
+  });
+  cache.set(key, t);
+  return t;
+}
+
+const loadImage = (src) => new Promise((resolve, reject) => {
+  const img = new Image();
+  img.onload = () => resolve(img);
+  img.onerror = reject;
+  img.src = src;
+});
+
+// Shows state.diff with the chosen scale; the legend says which.
+async function showDiff() {
+  const { image, scale } = state.diff;
+  const mode = $("diff-top").value;
+  if (mode === "largest" || !(scale > 0)) {
+    $("diff-scale").textContent = `${formatNumber(scale)} (the largest)`;
+    return showImage($("diff"), image);
+  }
+  const img = await loadImage(imageUrl(image));
+  const canvas = document.createElement("canvas");
+  canvas.width = img.naturalWidth;
+  canvas.height = img.naturalHeight;
+  const ctx = canvas.getContext("2d");
+  ctx.drawImage(img, 0, 0);
+  const pixels = ctx.getImageData(0, 0, canvas.width, canvas.height);
+  const data = pixels.data, cache = new Map();
+  const values = new Float32Array(data.length / 4).fill(-1);
+  for (let i = 0; i < data.length; i += 4) {
+    if (data[i + 3] > 0) values[i / 4] = rampPosition(data[i], data[i + 1], data[i + 2], cache) * scale;
+  }
+  const covered = values.filter((v) => v >= 0).sort();
+  let map, legend;
+  if (mode === "log") {
+    const floor = 1 / 255;  // one step of an 8-bit colour
+    map = (v) => Math.log1p(v / floor) / Math.log1p(scale / floor);
+    legend = `${formatNumber(scale)} (logarithmic from ${formatNumber(floor)})`;
+  } else {
+    const q = Number(mode);  // a percentile
+    const top = Math.max(covered[Math.min(covered.length - 1, Math.floor((q / 100) * covered.length))] || 0,
+                         1 / 255);
+    map = (v) => v / top;
+    legend = `${formatNumber(top)} (${q}th percentile; brighter pixels clamped)`;
+  }
+  values.forEach((v, k) => {
+    if (v < 0) return;
+    const rgb = heatRamp(map(v));
+    for (let c = 0; c < 3; c++) data[4 * k + c] = Math.round(rgb[c] * 255);
+  });
+  ctx.putImageData(pixels, 0, 0);
+  $("diff-scale").textContent = legend;
+  return new Promise((resolve) => {
+    $("diff").onload = $("diff").onerror = () => resolve();
+    $("diff").src = canvas.toDataURL("image/png");
+  });
 }
 
 // ---------------------------------------------------------------- metrics table
@@ -1110,6 +1195,7 @@ function bindControls() {
   }
   $("slider").addEventListener("input", applyLayout);
   $("orthographic").addEventListener("change", () => { describeView(); renderFull(); });
+  $("diff-top").addEventListener("change", () => { if (state.diff) showDiff(); });
   for (const button of document.querySelectorAll("[data-view]")) {
     button.addEventListener("click", () => standardView(button.dataset.view));
   }
@@ -1235,6 +1321,7 @@ const SHARED_CONTROLS = {
   presub: "presubdivide", poly: "polygonizer", res: "resolution", flatness: "flatness",
   surface: "draw-surface", cage: "draw-cage", wire: "draw-wireframe", contours: "draw-contours",
   shading: "shading", size: "size", bg: "background", compare: "compare", ortho: "orthographic",
+  dtop: "diff-top",
 };
 const controlDefaults = {};
 

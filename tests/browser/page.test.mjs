@@ -468,13 +468,39 @@ describe("limn's page", () => {
     }
     const answer = await page.evaluate(() => window.limnPage.lastAnswer.metrics);
     assert.ok(answer.silhouette.hausdorffPx > 0, "level 1 should differ from the limit");
-    const scale = Number(await page.textContent("#diff-scale"));
+    const scale = parseFloat(await page.textContent("#diff-scale"));
     assert.ok(scale > 0 && scale <= 1, `diff scale ${scale}`);
     assert.ok(await inkFraction("#reference") > 0.05, "the reference is blank");
     assert.ok(await inkFraction("#diff") > 0.02, "the diff is blank");
     await shot("compare");
+    // Topped by a percentile instead of the largest difference, more of the image is bright.
+    const bright = () => page.$eval("#diff", (img) => {
+      const canvas = document.createElement("canvas");
+      canvas.width = img.naturalWidth;
+      canvas.height = img.naturalHeight;
+      const ctx = canvas.getContext("2d");
+      ctx.drawImage(img, 0, 0);
+      const { data } = ctx.getImageData(0, 0, canvas.width, canvas.height);
+      let covered = 0, lit = 0;
+      for (let i = 0; i < data.length; i += 4) {
+        if (data[i + 3] === 0) continue;
+        covered += 1;
+        lit += data[i] + data[i + 1] + data[i + 2] > 150;
+      }
+      return lit / covered;
+    });
+    const linear = await bright();
+    await page.selectOption("#diff-top", "90");
+    await page.waitForFunction(() => /90th percentile/.test(document.querySelector("#diff-scale").textContent));
+    const percentile = await bright();
+    console.log(`difference image: ${(100 * linear).toFixed(1)}% of covered pixels bright with ` +
+                `the largest on top, ${(100 * percentile).toFixed(1)}% with the 90th percentile`);
+    assert.ok(percentile > 1.5 * linear, `${linear} -> ${percentile}`);
+    await shot("compare-percentile", page.locator("#panels"));
+    await page.selectOption("#diff-top", "largest");
     await page.check("input[value=slider]");
     await shot("compare-slider", page.locator("#approx-panel"));
+    assert.ok(await page.isVisible("#slider-divider"), "no divider on the slider");
   });
   it("renders an implicit scene, with its polygoniser and the reference", async () => {
     const options = await page.$$eval("#example option", (os) => os.map((o) => o.value));
