@@ -11,7 +11,11 @@ const DEFAULT_VIEW = { azimuthDeg: 30, elevationDeg: 20, distance: null };
 let firstView = DEFAULT_VIEW;  // the example's own view (examples.json "orbit"), else DEFAULT_VIEW
 const PREVIEW_DIVISOR = 4;  // drag previews render at a quarter of the size in each direction
 const LOCAL_MAX_TRIANGLES = 400_000;  // larger approximations are previewed by small renders
-const LOCAL_MAX_SIDE = 768;  // the local view's drawing buffer during a drag (scaled up to fit)
+// The local view's level of detail while dragging: an approximation of more triangles is drawn
+// coarser (fewer iterations, a coarser dicing rate: see dragParams), into a drawing buffer of at
+// most LOCAL_MAX_SIDE a side (scaled up to fit the panel).
+const DRAG_TRIANGLES = 20_000;
+const LOCAL_MAX_SIDE = 768;
 // The server's default limits (docs/api.md, "Limits"; configs/default.json). The number
 // controls carry them as min/max, and a value outside them is refused here, at its control,
 // instead of being sent (the server would answer 400 or 413 naming the same limit).
@@ -30,6 +34,7 @@ const page = (window.limnPage = {
   firstPictureMs: null,  // performance.now() when the first full-size picture was shown
   dragToFullMs: null,    // from the last drag's end to its full-size picture
   lastAnswer: null,
+  get dragTriangles() { return state.glView?.triangles ?? 0; },  // what the local view draws
   get requestSize() { return requestSize(); },  // {width, height} of the next full picture
   get layout() { return { ...layout }; },        // the panels' picture size in CSS pixels
   get busy() { return state.full !== null; },  // a full-size render is in flight
@@ -401,20 +406,41 @@ async function loadTessellation(triangles) {
   const view = state.glView;
   if (!view || !state.mesh || state.scene) return;  // scenes are previewed by small renders
   const key = tessellationKey();
-  if (view.key === key || $("method").value === "limit" || triangles > LOCAL_MAX_TRIANGLES) return;
+  const method = $("method").value;
+  if (view.key === key || method === "limit") return;
+  if (!COARSENED.includes(method) && triangles > LOCAL_MAX_TRIANGLES) return;
   state.tessellation?.abort();
   const controller = (state.tessellation = new AbortController());
   try {
     const glb = await state.mesh.withId(
         (mesh) => postBinary("/v1/tessellate",
-                             { mesh, camera: cameraFor(requestSize()), method: $("method").value,
-                               params: methodParams() },
+                             { mesh, camera: cameraFor(requestSize()), method,
+                               params: dragParams(triangles) },
                              { signal: controller.signal, accept: "model/gltf-binary" }),
         controller.signal);
     view.setMesh(parseGlb(glb), key);
   } catch (problem) {
     if (problem.name !== "AbortError") console.warn("no local view:", problem.message);
   }
+}
+
+// The methods whose drag view can be coarser than the picture.
+const COARSENED = ["uniform", "adaptive", "patches"];
+
+// The parameters of the approximation the local view draws: the method's own, or, when it has
+// more than DRAG_TRIANGLES triangles, fewer iterations (each one is 4 times the triangles) or a
+// dicing rate coarser by the square root of the excess.
+function dragParams(triangles) {
+  const method = $("method").value, params = methodParams();
+  const excess = triangles / DRAG_TRIANGLES;
+  if (excess <= 1) return params;
+  if (method === "uniform") {
+    return { ...params, level: Math.max(0, params.level - Math.ceil(Math.log(excess) / Math.log(4))) };
+  }
+  if (method === "adaptive" || method === "patches") {
+    return { ...params, dicingRate: params.dicingRate * Math.sqrt(excess) };
+  }
+  return params;
 }
 
 let frameRequested = false;
@@ -426,7 +452,8 @@ function drawLocal() {
     frameRequested = false;
     if (!state.glView?.ready || !state.frame) return;
     const full = requestSize();
-    state.glView.draw(orbitCamera(), scaled(full, Math.min(1, LOCAL_MAX_SIDE / Math.max(full.width, full.height))), {
+    const fit = Math.min(1, LOCAL_MAX_SIDE / Math.max(full.width, full.height));
+    state.glView.draw(orbitCamera(), scaled(full, fit), {
       surface: $("draw-surface").checked, cage: $("draw-cage").checked,
       flat: $("shading").value === "flat", opaque: $("background").value !== "transparent",
     });

@@ -229,6 +229,19 @@ describe("limn's page", () => {
     await page.$eval("#gl-canvas", (c) => { c.hidden = true; });
   });
 
+  it("draws a heavy approximation coarser while dragging", async () => {
+    const other = await browser.newPage({ viewport: { width: 1240, height: 800 } });
+    await other.goto(baseUrl + "/?example=torus_creased&level=5");
+    await other.waitForFunction(() => window.limnPage.localReady, null, { timeout: 120_000 });
+    const { full, drag } = await other.evaluate(() => ({
+      full: window.limnPage.lastAnswer.stats.triangles, drag: window.limnPage.dragTriangles,
+    }));
+    console.log(`level of detail: ${full} triangles in the picture, ${drag} while dragging`);
+    assert.equal(full, 96 * 2 * 4 ** 5);
+    assert.equal(drag, 96 * 2 * 4 ** 3, "the drag view is not 2 iterations coarser");
+    await other.close();
+  });
+
   it("previews a drag with small renders where it does not draw the view itself", async () => {
     const other = await browser.newPage({ viewport: { width: 1240, height: 800 } });
     await other.goto(baseUrl + "/?preview=server&example=cube");
