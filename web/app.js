@@ -92,6 +92,7 @@ function showError(problem) {
 
 function showMessage(slot, text) {
   $(slot).textContent = text;
+  $("stale-note").textContent = `out of date: ${text}`;
   $(slot).hidden = false;
   if (getComputedStyle($("controls")).visibility !== "hidden") {
     $(slot).scrollIntoView({ block: "nearest" });
@@ -294,6 +295,7 @@ async function renderFull() {
       state.dragEndedAt = null;
     }
     $("view").dataset.renders = String(page.renders);
+    state.shownExample = $("example").value;  // what an upload that fails goes back to
     rememberInAddress();
   } catch (problem) {
     if (problem.name === "AbortError") return;
@@ -799,29 +801,52 @@ async function useScene(request, label) {
   await renderFull();
 }
 
+// What is shown, to go back to when an upload is refused.
+function sourceSnapshot() {
+  return { mesh: state.mesh, meshText: state.meshText, meshFile: state.meshFile,
+           scene: state.scene, frame: state.frame, example: state.shownExample ?? $("example").value,
+           info: $("mesh-info").textContent };
+}
+
+function restoreSource(before) {
+  Object.assign(state, { mesh: before.mesh, meshText: before.meshText, meshFile: before.meshFile,
+                         scene: before.scene, frame: before.frame });
+  $("example").value = before.example;
+  $("mesh-info").textContent = before.info;
+  if (state.glView) {
+    const { points, faces } = state.meshText !== null ? cageOf(state.meshText) : { points: [], faces: [] };
+    state.glView.setCage(points, faces);
+  }
+  showSourceControls();
+}
+
 async function useMesh(source, label) {
+  const before = sourceSnapshot();
   state.meshFile = null;
   state.meshText = source;
   if (state.glView) {
     const { points, faces } = cageOf(source);
     state.glView.setCage(points, faces);
   }
-  await uploadAndRender(new UploadedMesh(wireMesh(source)), label);
+  await uploadAndRender(new UploadedMesh(wireMesh(source)), label, before);
 }
 
 // A file of a format the server reads (glTF, PLY, STL, ...), sent as it is. The server chooses
 // the scheme from its faces unless the person picked one for this file; the page has no cage
 // of it to draw itself.
 async function useMeshFile(file, scheme = null) {
+  const before = sourceSnapshot();
   state.meshText = null;
   state.meshFile = file;
   if (state.glView) state.glView.setCage([], []);
   const uploaded = new UploadedMesh(null, { bytes: file.bytes, format: file.format, scheme });
-  if (await uploadAndRender(uploaded, file.name)) $("scheme").value = uploaded.info.scheme;
+  if (await uploadAndRender(uploaded, file.name, before)) $("scheme").value = uploaded.info.scheme;
 }
 
-// Uploads the mesh and renders it; false (the error shown) when the upload was refused.
-async function uploadAndRender(uploaded, label) {
+// Uploads the mesh and renders it; false (the error shown under the mesh controls, and the
+// mesh shown before back, so that the controls and the camera still work) when the upload was
+// refused.
+async function uploadAndRender(uploaded, label, before) {
   state.full?.abort();
   stopTurntable();
   state.scene = null;
@@ -838,8 +863,7 @@ async function uploadAndRender(uploaded, label) {
     $("mesh-info").title = info.warnings.join("\n");
   } catch (problem) {
     setBusy(null);
-    state.mesh = null;
-    $("mesh-info").textContent = "";
+    restoreSource(before);
     showError(problem);
     return false;
   }

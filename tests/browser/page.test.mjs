@@ -334,6 +334,12 @@ describe("limn's page", () => {
     assert.match(text, /line 5/);
     assert.match(text, /face 1 uses vertex 7/);
     await shot("error-broken-obj");
+    // The mesh shown before is back: the controls still render it.
+    assert.match(await page.textContent("#mesh-info"), /96 vertices, 96 faces/);
+    const n = await set("#shading", "flat");
+    await waitForRenders(n + 1);
+    const m = await set("#shading", "smooth");
+    await waitForRenders(m + 1);
   });
 
   it("reads mesh files of other formats: OFF polygons, a binary STL of triangles", async () => {
@@ -435,6 +441,7 @@ describe("limn's page", () => {
                                { timeout: 60_000 });
     assert.ok(await page.isVisible("#stale-note"), "no note says the picture is out of date");
     assert.match(await page.textContent("#page-error"), /503: forced by the test/);
+    assert.match(await page.textContent("#stale-note"), /out of date: 503: forced by the test/);
     const dimmed = await page.$eval("#picture", (img) => Number(getComputedStyle(img).opacity));
     assert.ok(dimmed < 0.5, `the stale picture's opacity is ${dimmed}`);
     await shot("stale-after-error");
