@@ -25,6 +25,8 @@ void main() {
 const SURFACE_FS = `#version 300 es
 precision highp float;
 uniform vec3 uEye;
+uniform vec3 uForward;  // the view direction
+uniform bool uPerspective;
 uniform bool uFlat;
 in vec3 vPosition;
 in vec3 vNormal;
@@ -37,7 +39,8 @@ vec3 toSrgb(vec3 c) {
 }
 void main() {
   vec3 n = uFlat ? normalize(cross(dFdx(vPosition), dFdy(vPosition))) : normalize(vNormal);
-  vec3 toEye = normalize(uEye - vPosition);
+  // Orthographic: every ray runs along the view direction (render/raster/shaders.cpp).
+  vec3 toEye = uPerspective ? normalize(uEye - vPosition) : -uForward;
   float ndotv = dot(n, toEye);
   // The winding says front or back, as in limn's rasteriser (render/raster/shaders.cpp): a
   // smooth normal turned a little away near the outline must not paint a back-coloured fringe.
@@ -226,6 +229,9 @@ export class MeshView {
       gl.useProgram(this.surface);
       gl.uniformMatrix4fv(gl.getUniformLocation(this.surface, "uViewProj"), false, viewProj);
       gl.uniform3fv(gl.getUniformLocation(this.surface, "uEye"), camera.eye);
+      gl.uniform3fv(gl.getUniformLocation(this.surface, "uForward"), unit(sub(camera.target, camera.eye)));
+      gl.uniform1i(gl.getUniformLocation(this.surface, "uPerspective"),
+                   camera.projection === "orthographic" ? 0 : 1);
       gl.uniform1i(gl.getUniformLocation(this.surface, "uFlat"), what.flat ? 1 : 0);
       // The cage's lines win over the surface they lie on.
       gl.enable(gl.POLYGON_OFFSET_FILL);

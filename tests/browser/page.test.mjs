@@ -802,9 +802,26 @@ describe("limn's page", () => {
     await waitForRenders(n + 1);
     n = await set("#shading", "flat");
     await waitForRenders(n + 1);
+    // The local view draws the same orthographic, zoomed camera as the server.
+    await page.waitForFunction(() => window.limnPage.localReady, null, { timeout: 60_000 });
+    await keepPixels("#picture", "orthoServer");
+    await page.evaluate(async () => {
+      const img = new Image();
+      img.src = window.limnPage.localSnapshot();
+      await img.decode();
+      img.id = "ortho-snapshot";
+      img.hidden = true;
+      document.body.append(img);
+    });
+    await keepPixels("#ortho-snapshot", "orthoLocal");
+    await page.$eval("#ortho-snapshot", (img) => img.remove());
+    await page.$eval("#gl-canvas", (c) => { c.hidden = true; });
+    const disagree = await differingFraction("orthoServer", "orthoLocal");
+    console.log(`orthographic local view vs server picture: ${(100 * disagree).toFixed(2)}% differ`);
+    assert.ok(disagree < 0.03, `${(100 * disagree).toFixed(2)}% of the pixels differ`);
     await page.click("#copy-link");
     const url = await page.evaluate(() => location.href);
-    assert.match(url, /example=cube/);
+    assert.match(url, /example=\w+/);
     const want = await page.evaluate(() => ({
       camera: window.limnPage.lastAnswer.camera, level: document.querySelector("#level").value,
       shading: document.querySelector("#shading").value,
