@@ -1499,10 +1499,18 @@ function bindResize() {
     clearTimeout(timer);
     timer = setTimeout(renderFull, 300);
   });
-  const drawer = (open) => document.body.classList.toggle("drawer-open", open);
-  $("open-controls").addEventListener("click", () => drawer(true));
+  const drawer = (open) => {
+    document.body.classList.toggle("drawer-open", open);
+    $("open-controls").setAttribute("aria-expanded", String(open));
+  };
+  $("open-controls").addEventListener("click", (event) => {
+    event.stopPropagation();
+    drawer(true);
+  });
   $("close-controls").addEventListener("click", () => drawer(false));
   document.addEventListener("keydown", (event) => { if (event.key === "Escape") drawer(false); });
+  // A tap on the picture side closes the drawer.
+  document.querySelector("main").addEventListener("click", () => drawer(false));
 }
 
 async function start() {
