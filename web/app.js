@@ -296,6 +296,7 @@ async function renderFull() {
     }
     $("view").dataset.renders = String(page.renders);
     state.shownExample = $("example").value;  // what an upload that fails goes back to
+    state.shownScheme = $("scheme").value;
     rememberInAddress();
   } catch (problem) {
     if (problem.name === "AbortError") return;
@@ -805,13 +806,14 @@ async function useScene(request, label) {
 function sourceSnapshot() {
   return { mesh: state.mesh, meshText: state.meshText, meshFile: state.meshFile,
            scene: state.scene, frame: state.frame, example: state.shownExample ?? $("example").value,
-           info: $("mesh-info").textContent };
+           scheme: state.shownScheme ?? $("scheme").value, info: $("mesh-info").textContent };
 }
 
 function restoreSource(before) {
   Object.assign(state, { mesh: before.mesh, meshText: before.meshText, meshFile: before.meshFile,
                          scene: before.scene, frame: before.frame });
   $("example").value = before.example;
+  $("scheme").value = before.scheme;  // a scheme the server refused for this mesh is not kept
   $("mesh-info").textContent = before.info;
   if (state.glView) {
     const { points, faces } = state.meshText !== null ? cageOf(state.meshText) : { points: [], faces: [] };

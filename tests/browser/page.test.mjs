@@ -354,6 +354,17 @@ describe("limn's page", () => {
     await waitForRenders(renders + 1);
     assert.equal(await page.$eval("#scheme", (el) => el.value), "catmull-clark");
     assert.ok(await inkFraction("#picture") > 0.05, "the OFF cube is not drawn");
+    // Loop on its quads is refused: the message names the scheme, and the file, its scheme and
+    // its picture stay.
+    await page.selectOption("#scheme", "loop");
+    await page.locator("#mesh-error").waitFor({ state: "visible" });
+    assert.match(await page.textContent("#mesh-error"), /422: .*loop scheme takes triangles only/);
+    assert.match(await page.textContent("#mesh-info"), /cube\.off: 8 vertices, 6 faces/);
+    assert.equal(await page.$eval("#scheme", (el) => el.value), "catmull-clark");
+    renders = await set("#shading", "flat");
+    await waitForRenders(renders + 1);
+    renders = await set("#shading", "smooth");
+    await waitForRenders(renders + 1);
 
     // A binary STL tetrahedron: every face a triangle, so Loop; its corners welded into 4.
     const corners = [[1, 1, 1], [-1, -1, 1], [-1, 1, -1], [1, -1, -1]];
