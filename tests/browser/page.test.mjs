@@ -689,6 +689,16 @@ describe("limn's page", () => {
         assert.ok(await other.isVisible("#reference-panel .drag-note"));
         await other.mouse.up();
         assert.ok(opacity < 0.5, `the reference's opacity during a drag is ${opacity}`);
+        // Turned into a phone: laid out again, and a picture of the new size is asked for.
+        await other.waitForFunction(() => !window.limnPage.busy);
+        const n = await other.evaluate(() => window.limnPage.renders);
+        await other.setViewportSize({ width: 390, height: 844 });
+        await other.waitForFunction((k) => window.limnPage.renders > k && !window.limnPage.busy, n,
+                                    { timeout: 60_000 });
+        const boxes = await pictureBoxes(other);
+        for (const b of boxes) {
+          assert.ok(b.right <= 390.5 && Math.abs(b.natural - b.width) <= 1, JSON.stringify(b));
+        }
       }
       await other.close();
     });
