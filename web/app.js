@@ -37,7 +37,8 @@ const page = (window.limnPage = {
   get dragTriangles() { return state.glView?.triangles ?? 0; },  // what the local view draws
   get requestSize() { return requestSize(); },  // {width, height} of the next full picture
   get layout() { return { ...layout }; },        // the panels' picture size in CSS pixels
-  get busy() { return state.full !== null; },  // a full-size render is in flight
+  // A full-size render (or a mesh's upload) is in flight.
+  get busy() { return state.full !== null || state.uploads > 0; },
   // The local view holds the approximation the settings ask for (drags will draw it).
   get localReady() {
     return Boolean(state.glView?.ready && state.glView.key === tessellationKey() && state.frame);
@@ -67,6 +68,7 @@ const state = {
   tessellation: null,   // AbortController of the POST /v1/tessellate in flight
   turntableTimer: null,  // the interval that plays a turntable's views
   scene: null,          // an implicit scene ({field, ...}: a /v1/implicit request) instead of a mesh
+  uploads: 0,           // mesh uploads in flight
 };
 
 // An implicit scene sent whole with every request; it stands where an UploadedMesh would.
@@ -847,7 +849,7 @@ async function useMeshFile(file, scheme = null) {
 
 // Uploads the mesh and renders it; false (the error shown under the mesh controls, and the
 // mesh shown before back, so that the controls and the camera still work) when the upload was
-// refused.
+// refused, and false, touching nothing, when a newer mesh (or scheme) was picked meanwhile.
 async function uploadAndRender(uploaded, label, before) {
   state.full?.abort();
   stopTurntable();
@@ -857,17 +859,22 @@ async function uploadAndRender(uploaded, label, before) {
   state.frame = null;  // until the first answer for this mesh
   clearErrors();
   setBusy("uploading the mesh…");
+  state.uploads += 1;
   try {
     const info = await uploaded.upload();
+    if (state.mesh !== uploaded) return false;
     $("mesh-info").textContent = `${label}: ${info.vertices.toLocaleString("en")} vertices, ` +
         `${info.faces.toLocaleString("en")} faces` +
         (info.warnings.length ? ` (${info.warnings.length} warnings)` : "");
     $("mesh-info").title = info.warnings.join("\n");
   } catch (problem) {
+    if (state.mesh !== uploaded) return false;
     setBusy(null);
     restoreSource(before);
     showError(problem);
     return false;
+  } finally {
+    state.uploads -= 1;
   }
   hideContours();
   await renderFull();
