@@ -8,7 +8,7 @@
 // every 16 ms, and prints how many frames the page showed per second: the ones it drew itself
 // (WebGL) and the server previews that landed. bench/web_drag_fps.md keeps the last run.
 //
-//   node bench/web_drag_fps.mjs [--levels 2,4,5,6] [--seconds 2]
+//   node bench/web_drag_fps.mjs [--levels 2,4,5,6] [--seconds 2] [--window 1240x800]
 import { spawn } from "node:child_process";
 import { createRequire } from "node:module";
 import path from "node:path";
@@ -22,6 +22,7 @@ const option = (name, fallback) => {
 };
 const levels = option("levels", "2,4,5,6").split(",").map(Number);
 const seconds = Number(option("seconds", "2"));
+const [width, height] = option("window", "1240x800").split("x").map(Number);
 const require = createRequire(path.join(root, "build/browser-tests/node_modules/index.js"));
 const { chromium } = require("playwright-core");
 
@@ -43,7 +44,7 @@ const browser = await chromium.launch({
 console.log("| iterations | triangles | drag view | frames/s shown  drag end to full picture (ms) |");
 console.log("| --- | --- | --- | --- | --- |");
 for (const level of levels) {
-  const page = await browser.newPage({ viewport: { width: 1240, height: 800 } });
+  const page = await browser.newPage({ viewport: { width, height } });
   await page.goto(`${base}/?example=torus_creased&level=${level}`);
   await page.waitForFunction(() => window.limnPage.renders >= 1 && !window.limnPage.busy, null,
                              { timeout: 300_000 });
