@@ -109,6 +109,7 @@ void writeReference(Writer& w, const CompareResult& result, const CompareRequest
     w.StartObject();
     w.Key("camera");
     w.Uint64(c);
+    numberField(w, "accuracyPx", ref.stats.accuracyPx);
     w.Key("timings");
     w.StartObject();
     numberField(w, "referenceMs", ref.referenceMs);

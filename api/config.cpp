@@ -150,6 +150,7 @@ void readLimits(const Value& object, const std::string& source, ServiceConfig& c
   r.integer("maxSearchSteps", limits.maxSearchSteps, 0);
   r.integer("maxCurveSamples", limits.maxCurveSamples, 0);
   r.size("maxTriangles", limits.maxTriangles, 1);
+  r.size("maxReferenceTriangles", limits.maxReferenceTriangles, 1000);
   r.integer("maxPrimitives", limits.maxPrimitives, 1);
   r.integer("maxResolution", limits.maxResolution, 2);
   r.size("maxExpressionLength", limits.maxExpressionLength, 1);

@@ -389,6 +389,9 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
       w.EndObject();
       warnings.push_back("the reference was requested but not produced");
     }
+    if (result.timings.reference && result.timings.reference->accuracyPx > 0) {
+      numberField(w, "accuracyPx", result.timings.reference->accuracyPx);  // mesh references
+    }
     w.EndObject();
   }
   const double encodeMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();

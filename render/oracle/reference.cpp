@@ -93,9 +93,9 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 
   std::shared_ptr<const ReferenceScene> built;
   if (options.cache) {
-    built = options.cache->get(surface, camera, cancel, &stats.sceneCached);
+    built = options.cache->get(surface, camera, cancel, &stats.sceneCached, options.triangleBudget);
   } else {
-    built = buildReferenceScene(surface, camera, cancel);
+    built = buildReferenceScene(surface, camera, cancel, options.triangleBudget);
   }
   const ReferenceTessellation& tessellation = built->tessellation;
   const tessellate::TriangleMesh& mesh = tessellation.mesh;
@@ -108,17 +108,15 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
     stats.tessellateMs = built->tessellateMs;
     stats.bvhMs = built->bvhMs;
   }
-  if (tessellation.ratesScaled < 1) {
-    result.warnings.push_back("reference: tessellation rates scaled by " +
-                              std::to_string(tessellation.ratesScaled) + " to stay within " +
-                              std::to_string(static_cast<long>(4 * kReferenceTriangleBudget)) +
-                              " triangles; the reference's outline is less exact than usual");
-  }
-  if (tessellation.outlineErrorPx > kOutlineChordErrorPx * 1.0001) {
+  // Every edge rate scaled by r leaves the chord error 1 / r^2 times larger.
+  stats.accuracyPx =
+      tessellation.outlineErrorPx / (tessellation.ratesScaled * tessellation.ratesScaled);
+  if (stats.accuracyPx > kOutlineChordErrorPx * 1.0001) {
     result.warnings.push_back(
-        "reference: outline chord error raised to " + std::to_string(tessellation.outlineErrorPx) +
+        "reference: outline chord error raised to " + std::to_string(stats.accuracyPx) +
         " px (from " + std::to_string(kOutlineChordErrorPx) + ") to stay within " +
-        std::to_string(static_cast<long>(kReferenceTriangleBudget)) + " triangles");
+        std::to_string(static_cast<long>(options.triangleBudget)) +
+        " triangles: outline distances below that cannot be told from the reference's own error");
   }
   cancel.check();
 

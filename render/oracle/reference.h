@@ -35,12 +35,16 @@ struct ReferenceStats {
   double tessellateMs = 0, bvhMs = 0, traceMs = 0;  // 0 for the first two on a cache hit
   size_t outlineFaces = 0;    // faces tessellated finely because they carry an outline
   double outlineErrorPx = 0;  // chord error aimed for at the outline, output pixels
-  size_t hits = 0;            // output pixels covered
-  double newtonMs = 0;        // refinement and shading of the hits (traceMs: primary rays only)
-  double maskMs = 0;          // the supersampled mask's rays
-  double outlineMs = 0;       // locating the outline to sub-pixel precision
-  size_t refinedPixels = 0;   // output pixels whose S x S samples were all cast
-  bool sceneCached = false;   // the tessellation and BVH came from the cache
+  // A bound on the reference's own outline error, output pixels: the outline's chord error as
+  // tessellated (0.01 within the triangle budget; raised when the budget or the rate cap
+  // binds). The continuous outline metrics cannot resolve differences below it.
+  double accuracyPx = 0;
+  size_t hits = 0;           // output pixels covered
+  double newtonMs = 0;       // refinement and shading of the hits (traceMs: primary rays only)
+  double maskMs = 0;         // the supersampled mask's rays
+  double outlineMs = 0;      // locating the outline to sub-pixel precision
+  size_t refinedPixels = 0;  // output pixels whose S x S samples were all cast
+  bool sceneCached = false;  // the tessellation and BVH came from the cache
 };
 
 struct ReferenceResult {
@@ -76,6 +80,8 @@ struct ReferenceOptions {
   const std::vector<uint8_t>* hintBlocks = nullptr;
   bool locateOutline = false;            // needs passes.supersample > 0
   ReferenceSceneCache* cache = nullptr;  // where to find and keep the tessellation and BVH
+  // Triangles the dense tessellation aims to stay within (reference_tessellation.h).
+  double triangleBudget = kReferenceTriangleBudget;
   // The rasteriser's sample positions for an anti-aliased picture (Rasterizer::samplePositions):
   // with more than one, the colour of pixels along edges is the mean of rays through them, as
   // the rasteriser resolves its samples (antialiasEdges in reference_passes.h).

@@ -88,10 +88,11 @@ std::vector<char> outlineCandidates(const ReferenceTessellation& tessellation,
 
 std::shared_ptr<const ReferenceScene> buildReferenceScene(const subdiv::LimitSurface& surface,
                                                           const Camera& camera,
-                                                          const CancelToken& cancel) {
+                                                          const CancelToken& cancel,
+                                                          double triangleBudget) {
   auto scene = std::make_shared<ReferenceScene>();
   auto start = std::chrono::steady_clock::now();
-  scene->tessellation = tessellateForReference(surface, camera, cancel);
+  scene->tessellation = tessellateForReference(surface, camera, cancel, triangleBudget);
   scene->tessellateMs = msSince(start);
   cancel.check();
   start = std::chrono::steady_clock::now();
@@ -104,22 +105,23 @@ std::shared_ptr<const ReferenceScene> buildReferenceScene(const subdiv::LimitSur
   return scene;
 }
 
-std::string referenceSceneKey(const subdiv::LimitSurface& surface, const Camera& c) {
+std::string referenceSceneKey(const subdiv::LimitSurface& surface, const Camera& c,
+                              double triangleBudget) {
   char view[512];
-  std::snprintf(
-      view, sizeof view,
-      "|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g|%d|%.17g|%dx%d|%.17g,%.17g",
-      c.eye().x, c.eye().y, c.eye().z, c.target().x, c.target().y, c.target().z, c.up().x, c.up().y,
-      c.up().z, c.fovYDeg(), static_cast<int>(c.projection()), c.orthoHeight(), c.width(),
-      c.height(), c.nearPlane(), c.farPlane());
+  std::snprintf(view, sizeof view,
+                "|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g,%.17g,%.17g|%.17g|%d|%.17g|%dx%d|%.17g,"
+                "%.17g|%.17g",
+                c.eye().x, c.eye().y, c.eye().z, c.target().x, c.target().y, c.target().z, c.up().x,
+                c.up().y, c.up().z, c.fovYDeg(), static_cast<int>(c.projection()), c.orthoHeight(),
+                c.width(), c.height(), c.nearPlane(), c.farPlane(), triangleBudget);
   return mesh::contentHash(surface.mesh()) + "|" + surface.displacementSpec().key() + view;
 }
 
 std::shared_ptr<const ReferenceScene> ReferenceSceneCache::get(const subdiv::LimitSurface& surface,
                                                                const Camera& camera,
-                                                               const CancelToken& cancel,
-                                                               bool* hit) {
-  const std::string key = referenceSceneKey(surface, camera);
+                                                               const CancelToken& cancel, bool* hit,
+                                                               double triangleBudget) {
+  const std::string key = referenceSceneKey(surface, camera, triangleBudget);
   {
     std::lock_guard lock(mutex_);
     auto it = index_.find(key);
@@ -132,7 +134,8 @@ std::shared_ptr<const ReferenceScene> ReferenceSceneCache::get(const subdiv::Lim
     ++misses_;
   }
   *hit = false;
-  std::shared_ptr<const ReferenceScene> scene = buildReferenceScene(surface, camera, cancel);
+  std::shared_ptr<const ReferenceScene> scene =
+      buildReferenceScene(surface, camera, cancel, triangleBudget);
   std::lock_guard lock(mutex_);
   insertLocked(key, scene);
   return scene;

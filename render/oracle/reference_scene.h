@@ -36,12 +36,14 @@ struct ReferenceScene {
   size_t bytes = 0;                    // estimated memory: mesh arrays + Embree's BVH
 };
 
-std::shared_ptr<const ReferenceScene> buildReferenceScene(const subdiv::LimitSurface& surface,
-                                                          const Camera& camera,
-                                                          const CancelToken& cancel);
+std::shared_ptr<const ReferenceScene> buildReferenceScene(
+    const subdiv::LimitSurface& surface, const Camera& camera, const CancelToken& cancel,
+    double triangleBudget = kReferenceTriangleBudget);
 
-// The cache key: the mesh's content hash, its displacement and every camera parameter.
-std::string referenceSceneKey(const subdiv::LimitSurface& surface, const Camera& camera);
+// The cache key: the mesh's content hash, its displacement, every camera parameter and the
+// triangle budget.
+std::string referenceSceneKey(const subdiv::LimitSurface& surface, const Camera& camera,
+                              double triangleBudget = kReferenceTriangleBudget);
 
 class ReferenceSceneCache {
  public:
@@ -51,7 +53,8 @@ class ReferenceSceneCache {
   // The scene of `surface` seen by `camera`, built when missing; *hit says which.
   std::shared_ptr<const ReferenceScene> get(const subdiv::LimitSurface& surface,
                                             const Camera& camera, const CancelToken& cancel,
-                                            bool* hit);
+                                            bool* hit,
+                                            double triangleBudget = kReferenceTriangleBudget);
 
   struct Counters {
     size_t hits = 0, misses = 0, evictions = 0, entries = 0, bytes = 0, capacityBytes = 0;

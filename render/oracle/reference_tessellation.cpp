@@ -84,25 +84,38 @@ double estimateTriangles(const std::vector<FaceProbe>& probes, const std::vector
   return total;
 }
 
+// Over the budget, the triangles away from outlines go first: they only start Newton and decide
+// visibility inside the outline, so their edges may grow to kReferenceMaxDicingRate pixels.
+// Only then does the outline's chord error rise (its triangles go as 1 / error), and with it
+// the accuracy the answer reports.
+void fitToBudget(const std::vector<FaceProbe>& probes, const std::vector<char>& outline,
+                 double budget, ReferenceTessellation& result) {
+  result.outlineErrorPx = kOutlineChordErrorPx;
+  result.dicingRate = kReferenceDicingRate;
+  auto estimate = [&] {
+    return estimateTriangles(probes, outline, result.outlineErrorPx, result.dicingRate);
+  };
+  while (result.dicingRate < kReferenceMaxDicingRate && estimate() > budget) {
+    result.dicingRate = std::min(result.dicingRate * 1.5, kReferenceMaxDicingRate);
+  }
+  for (int step = 0; step < 8; ++step) {  // the interior's share stays: a few steps converge
+    const double over = estimate() / budget;
+    if (over <= 1.0) break;
+    result.outlineErrorPx *= over * 1.05;
+  }
+}
+
 }  // namespace
 
 ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface,
-                                             const Camera& camera, const CancelToken& cancel) {
+                                             const Camera& camera, const CancelToken& cancel,
+                                             double triangleBudget) {
   std::vector<FaceProbe> probes = probeFaces(surface, camera);
   ReferenceTessellation result;
   std::vector<char> outline = outlineFaces(surface, probes, result.borderFaces);
   cancel.check();
 
-  // Within the budget, both the outline's segments and the dicing scale as 1 / sqrt(error):
-  // triangles go as 1 / error.
-  result.outlineErrorPx = kOutlineChordErrorPx;
-  result.dicingRate = kReferenceDicingRate;
-  double estimate = estimateTriangles(probes, outline, kOutlineChordErrorPx, kReferenceDicingRate);
-  if (estimate > kReferenceTriangleBudget) {
-    double factor = estimate / kReferenceTriangleBudget;
-    result.outlineErrorPx *= factor;
-    result.dicingRate *= std::sqrt(factor);
-  }
+  fitToBudget(probes, outline, triangleBudget, result);
 
   // Segments per edge; where the rate cap cuts them short, the error grows as 1 / rate^2.
   const Far::TopologyLevel& base = surface.baseLevel();
@@ -126,7 +139,7 @@ ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface
   options.dicingRate = result.dicingRate;
   options.maxEdgeRate = kReferenceMaxEdgeRate;
   options.minEdgeRate = 1;
-  options.maxTriangles = 4 * static_cast<size_t>(kReferenceTriangleBudget);
+  options.maxTriangles = 4 * static_cast<size_t>(triangleBudget);
   options.fitToBudget = true;
   options.stage = "reference";
   options.remedy = "";

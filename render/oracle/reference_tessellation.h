@@ -28,11 +28,13 @@ inline constexpr double kReferenceDicingRate = 2.0;
 // Target chord error of outline faces, in output pixels: an eighth of a supersampled pixel at
 // S = 8 is 0.016; this keeps below that with margin.
 inline constexpr double kOutlineChordErrorPx = 0.01;
+// The edge length away from outlines may grow to this when the budget needs it (fitToBudget).
+inline constexpr double kReferenceMaxDicingRate = 16.0;
 // Segments per edge at most (Bfr tessellation rate).
 inline constexpr int kReferenceMaxEdgeRate = 512;
 // Triangles the reference aims to stay within (estimated before tessellating; Embree needs
-// roughly 100 bytes per triangle). Beyond it the outline error and the dicing rate are raised
-// together, and the caller is told.
+// roughly 100 bytes per triangle). Beyond it the dicing rate away from outlines is raised first,
+// then the outline error, and the caller is told (ReferenceStats::accuracyPx).
 inline constexpr double kReferenceTriangleBudget = 3e6;
 
 struct ReferenceTessellation {
@@ -48,8 +50,10 @@ struct ReferenceTessellation {
   double ratesScaled = 1;
 };
 
-// `camera` is the output camera (not the supersampled one).
+// `camera` is the output camera (not the supersampled one); `triangleBudget` as
+// kReferenceTriangleBudget (the server's limits.maxReferenceTriangles).
 ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface,
-                                             const Camera& camera, const CancelToken& cancel);
+                                             const Camera& camera, const CancelToken& cancel,
+                                             double triangleBudget = kReferenceTriangleBudget);
 
 }  // namespace limn::render::oracle

@@ -115,13 +115,14 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
       .camera = camera, .stats = {}, .referenceMs = 0, .images = {}, .warnings = {}};
   if (!hint.empty()) {  // else every method failed: nothing to measure
     Stopwatch clock;
-    oracle::ReferenceResult reference =
-        oracle::renderReference(surface, camera, referencePasses(true, S), cancel,
-                                {.maskHint = nullptr,
-                                 .hintBlocks = &hint,
-                                 .locateOutline = true,
-                                 .cache = context.referenceCache,
-                                 .colorSamples = colorSamples(context, job.outputs)});
+    oracle::ReferenceResult reference = oracle::renderReference(
+        surface, camera, referencePasses(true, S), cancel,
+        {.maskHint = nullptr,
+         .hintBlocks = &hint,
+         .locateOutline = true,
+         .cache = context.referenceCache,
+         .triangleBudget = static_cast<double>(limits.maxReferenceTriangles),
+         .colorSamples = colorSamples(context, job.outputs)});
     ref.referenceMs = clock.lapMs();
     ref.stats = reference.stats;
     ref.warnings = reference.warnings;
@@ -134,6 +135,9 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
       row.metrics =
           measureDrawing(*drawings[m], reference, surface, camera, S, job.outputs.diff, cancel);
       row.timings.metricsMs = metricsClock.lapMs();
+      if (auto note = referenceAccuracyNote(row.metrics, reference.stats)) {
+        row.warnings.push_back(*note);
+      }
       row.stats.referenceTriangles = reference.stats.triangles;
       fillRow(job, *drawings[m], row);
       drawings[m].reset();

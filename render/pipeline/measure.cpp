@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <optional>
+#include <string>
 
 #include "render/metrics/metrics.h"
 
@@ -58,6 +59,16 @@ void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camer
   result.metrics.image = m.image;
   result.metrics.depth = m.depth;
   result.metrics.normal = m.normal;
+}
+
+std::optional<std::string> referenceAccuracyNote(const metrics::Metrics& metrics,
+                                                 const oracle::ReferenceStats& reference) {
+  if (!metrics.silhouette || !metrics.silhouette->outlineHausdorffPx) return std::nullopt;
+  const double distance = *metrics.silhouette->outlineHausdorffPx;
+  if (distance > reference.accuracyPx) return std::nullopt;
+  return "metrics: silhouette.outlineHausdorffPx (" + std::to_string(distance) +
+         " px) is within the reference's own accuracy (" + std::to_string(reference.accuracyPx) +
+         " px): the outline's error is at most that, not known more closely";
 }
 
 ImageSet selectOutputs(ImageSet images, const Outputs& outputs, bool isReference) {

@@ -2,6 +2,9 @@
 // images measured against its reference, and the answer's passes picked from what was rendered.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
 #include "render/metrics/metrics.h"
@@ -24,6 +27,11 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
 void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camera& camera, int S,
                              const oracle::ReferenceResult& reference, double diagonal, bool diff,
                              const CancelToken& cancel, RenderResult& result);
+
+// A warning when the continuous outline distance is within the reference's own accuracy (the
+// difference cannot be told from the reference's error), or nothing.
+std::optional<std::string> referenceAccuracyNote(const metrics::Metrics& metrics,
+                                                 const oracle::ReferenceStats& reference);
 
 // Keeps only the passes the client asked for; the wireframe of the reference is its colour
 // (the exact surface has no edges to draw).

@@ -102,6 +102,10 @@ struct JobLimits {
   int maxSearchSteps = 30;
   int maxCurveSamples = 256;
   size_t maxTriangles = 8'000'000;
+  // Triangles the exact reference's dense tessellation aims to stay within (about 100 bytes
+  // each with its BVH); past it the reference coarsens away from outlines, then raises its
+  // outline chord error and says so (ReferenceStats::accuracyPx).
+  size_t maxReferenceTriangles = 3'000'000;
   // Implicit fields (runImplicit): primitives per field, polygonizer.resolution, characters of a
   // custom expression (its cost per evaluation is linear in its length).
   int maxPrimitives = 64;

@@ -167,7 +167,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     oracle::ReferenceOptions options{
         .maskHint = drawing ? &drawing->images.supersampledMask : nullptr,
         .locateOutline = measure,
-        .cache = context.referenceCache};
+        .cache = context.referenceCache,
+        .triangleBudget = static_cast<double>(limits.maxReferenceTriangles)};
     options.colorSamples = colorSamples(context, job.outputs);
     oracle::ReferenceResult reference =
         oracle::renderReference(surface, camera, referencePasses(measure, S), cancel, options);
@@ -186,6 +187,9 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     if (measure) {
       result.metrics =
           measureDrawing(*drawing, reference, surface, camera, S, job.outputs.diff, cancel);
+      if (auto note = referenceAccuracyNote(result.metrics, reference.stats)) {
+        result.warnings.push_back(*note);
+      }
     }
     if (job.method == Method::Limit) {
       result.images = selectOutputs(reference.images, job.outputs, true);
