@@ -94,7 +94,7 @@ function showError(problem) {
 
 function showMessage(slot, text) {
   $(slot).textContent = text;
-  $("stale-note").textContent = `out of date: ${text}`;
+  $("stale-text").textContent = `out of date: ${text}`;
   $(slot).hidden = false;
   if (getComputedStyle($("controls")).visibility !== "hidden") {
     $(slot).scrollIntoView({ block: "nearest" });
@@ -1028,6 +1028,7 @@ function bindCamera() {
   };
   view.addEventListener("pointerdown", (event) => {
     if (event.pointerType === "mouse" && event.button !== 0) return;
+    if (event.target.closest("button")) return;  // the retry button over the picture
     try { view.setPointerCapture(event.pointerId); } catch { /* a synthetic pointer */ }
     pointers.set(event.pointerId, [event.clientX, event.clientY]);
     if (pointers.size === 2) {
@@ -1267,6 +1268,7 @@ function bindControls() {
     button.addEventListener("click", () => downloadMesh(button.dataset.meshFormat));
   }
   $("copy-link").addEventListener("click", copyLink);
+  $("retry").addEventListener("click", renderFull);
 }
 
 // ---------------------------------------------------------------- export and share

@@ -456,10 +456,31 @@ describe("limn's page", () => {
     const dimmed = await page.$eval("#picture", (img) => Number(getComputedStyle(img).opacity));
     assert.ok(dimmed < 0.5, `the stale picture's opacity is ${dimmed}`);
     await shot("stale-after-error");
-    const renders = await set("#shading", "smooth");
+    // The note's retry sends the same request again, which succeeds this time.
+    const renders = await page.evaluate(() => window.limnPage.renders);
+    await page.click("#retry");
     await waitForRenders(renders + 1);
     assert.ok(!(await page.evaluate(() => document.body.classList.contains("stale"))));
     assert.ok(!(await page.isVisible("#stale-note")));
+    const n = await set("#shading", "smooth");
+    await waitForRenders(n + 1);
+  });
+
+  it("shows the server's warnings under the status line", async () => {
+    // The next answer carries a warning, added to the server's real answer.
+    await page.route("**/v1/render", async (route) => {
+      const response = await route.fetch();
+      const answer = await response.json();
+      answer.warnings = [...(answer.warnings || []), "a warning added by the test"];
+      await route.fulfill({ response, json: answer });
+    }, { times: 1 });
+    let n = await set("#shading", "flat");
+    await waitForRenders(n + 1);
+    assert.ok(await page.isVisible("#warnings"));
+    assert.match(await page.textContent("#warnings"), /a warning added by the test/);
+    n = await set("#shading", "smooth");
+    await waitForRenders(n + 1);
+    assert.ok(!(await page.isVisible("#warnings")), "the warning outlived its answer");
   });
 
   it("offers only what works: normal-map shading for coarse and silhouette, factored for " +
