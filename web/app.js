@@ -5,6 +5,9 @@
 // shows small renders, and the full-size picture follows when the drag ends. See docs/web.md.
 import { ApiProblem, UploadedMesh, getJson, getText, meshFileFormats, post, postBinary } from "/api.js";
 import { MeshView, parseGlb } from "/glview.js";
+import { LOG_FLOOR, rescaleDiff } from "/diff.js";
+import { formatNumber, metricsTables } from "/metrics.js";
+import { panelSize, pixelSize } from "/layout.js";
 
 const $ = (id) => document.getElementById(id);
 const DEFAULT_VIEW = { azimuthDeg: 30, elevationDeg: 20, distance: null };
@@ -191,56 +194,22 @@ const sliderLayout = () =>
 // picture, or two (slider: the approximation and the difference), or three side by side or
 // stacked, whichever leaves them largest; on a narrow screen each takes the whole width.
 const layout = { w: 512, h: 512 };
-const PANEL_GAP = 14, CAPTION = 22, SLIDER = 26;
 
 function layoutPanels() {
   document.body.classList.toggle("comparing", comparing());
-  const n = !comparing() ? 1 : sliderLayout() ? 2 : 3;
   const panels = $("panels");
-  const width = panels.clientWidth - 2;  // the frames' borders
   const top = panels.getBoundingClientRect().top + window.scrollY;
-  const height = window.innerHeight - top - 10;
-  const extra = CAPTION + (n === 2 ? SLIDER : 0);
-  let w, h;
-  if (n === 1) {
-    w = width;
-    h = Math.min(width, Math.max(height - extra, Math.min(width, 240)));
-  } else if (width < 600) {
-    w = h = width;
-  } else {
-    let best = 0;
-    for (let columns = 1; columns <= n; columns++) {
-      const rows = Math.ceil(n / columns);
-      const side = Math.min((width - (columns - 1) * PANEL_GAP) / columns,
-                            (height - rows * extra - (rows - 1) * PANEL_GAP) / rows);
-      best = Math.max(best, side);
-    }
-    w = h = Math.max(best, Math.min(width, 200));
-  }
-  layout.w = Math.max(64, Math.floor(w));
-  layout.h = Math.max(64, Math.floor(h));
+  Object.assign(layout, panelSize(panels.clientWidth - 2,  // the frames' borders
+                                  window.innerHeight - top - 10,
+                                  !comparing() ? 1 : sliderLayout() ? 2 : 3));
   panels.style.setProperty("--w", `${layout.w}px`);
   panels.style.setProperty("--h", `${layout.h}px`);
 }
 
 // The full picture's size in pixels: the panel's size in device pixels ("as shown"), or the
 // chosen size along the longer side, within MAX_REQUEST_SIDE.
-function requestSize() {
-  const choice = $("size").value;
-  let w = layout.w - 2, h = layout.h - 2, cap = MAX_REQUEST_SIDE;  // inside the frame's border
-  if (choice === "auto") {
-    const dpr = window.devicePixelRatio || 1;
-    w *= dpr;
-    h *= dpr;
-  } else {
-    cap = Number(choice);
-    const scale = cap / Math.max(w, h);
-    w *= scale;
-    h *= scale;
-  }
-  const scale = Math.min(1, cap / Math.max(w, h));
-  return { width: Math.max(16, Math.round(w * scale)), height: Math.max(16, Math.round(h * scale)) };
-}
+const requestSize = () => pixelSize(layout, $("size").value, window.devicePixelRatio || 1,
+                                    MAX_REQUEST_SIDE);
 
 const scaled = (size, factor) => ({ width: Math.max(16, Math.round(size.width * factor)),
                                     height: Math.max(16, Math.round(size.height * factor)) });
@@ -337,7 +306,7 @@ async function showAnswer(answer, compare) {
     state.diff = answer.images.diff ? { image: answer.images.diff, scale: answer.metrics.image?.diffScale }
                                     : null;
     if (state.diff) shown.push(showDiff());
-    fillMetrics(answer);
+    $("metrics").replaceChildren(...metricsTables(answer));
   }
   await Promise.all(shown);
 }
@@ -498,43 +467,7 @@ function hideContours() {
 
 // ---------------------------------------------------------------- the difference image
 
-// The server's difference image is linear from 0 (black) to its top, the largest difference of
-// any pixel (metrics.image.diffScale, pale yellow): one bad pixel leaves the rest dark. The page
-// can redraw it with another top — a percentile of the covered pixels' differences (brighter
-// ones clamped) — or on a logarithmic scale, reading each pixel's difference back from the
-// ramp's colour (the ramp of render/metrics/image_metrics.cpp, written as bytes without sRGB).
-const HEAT_STOPS = [[0.00, 0.00, 0.02], [0.34, 0.06, 0.43], [0.73, 0.21, 0.33], [0.98, 0.55, 0.04],
-                    [0.99, 1.00, 0.64]];
-
-function heatRamp(t) {
-  const x = Math.min(1, Math.max(0, t)) * 4, i = Math.min(Math.floor(x), 3), f = x - i;
-  return HEAT_STOPS[i].map((c, k) => c + f * (HEAT_STOPS[i + 1][k] - c));
-}
-
-const HEAT_TABLE = Array.from({ length: 1021 }, (_, k) => heatRamp(k / 1020).map((c) => c * 255));
-
-// The ramp position (0..1) of an 8-bit colour: the nearest of the table's colours.
-function rampPosition(r, g, b, cache) {
-  const key = (r << 16) | (g << 8) | b;
-  let t = cache.get(key);
-  if (t !== undefined) return t;
-  let best = Infinity;
-  HEAT_TABLE.forEach(([R, G, B], k) => {
-    const d = (R - r) ** 2 + (G - g) ** 2 + (B - b) ** 2;
-    if (d < best) { best = d; t = k / 1020; }
-  });
-  cache.set(key, t);
-  return t;
-}
-
-const loadImage = (src) => new Promise((resolve, reject) => {
-  const img = new Image();
-  img.onload = () => resolve(img);
-  img.onerror = reject;
-  img.src = src;
-});
-
-// Shows state.diff with the chosen scale; the legend says which.
+// Shows state.diff with the chosen scale (diff.js); the legend says which.
 async function showDiff() {
   const { image, scale } = state.diff;
   const mode = $("diff-top").value;
@@ -542,129 +475,14 @@ async function showDiff() {
     $("diff-scale").textContent = `${formatNumber(scale)} (the largest)`;
     return showImage($("diff"), image);
   }
-  const img = await loadImage(imageUrl(image));
-  const canvas = document.createElement("canvas");
-  canvas.width = img.naturalWidth;
-  canvas.height = img.naturalHeight;
-  const ctx = canvas.getContext("2d");
-  ctx.drawImage(img, 0, 0);
-  const pixels = ctx.getImageData(0, 0, canvas.width, canvas.height);
-  const data = pixels.data, cache = new Map();
-  const values = new Float32Array(data.length / 4).fill(-1);
-  for (let i = 0; i < data.length; i += 4) {
-    if (data[i + 3] > 0) values[i / 4] = rampPosition(data[i], data[i + 1], data[i + 2], cache) * scale;
-  }
-  const covered = values.filter((v) => v >= 0).sort();
-  let map, legend;
-  if (mode === "log") {
-    const floor = 1 / 255;  // one step of an 8-bit colour
-    map = (v) => Math.log1p(v / floor) / Math.log1p(scale / floor);
-    legend = `${formatNumber(scale)} (logarithmic from ${formatNumber(floor)})`;
-  } else {
-    const q = Number(mode);  // a percentile
-    const top = Math.max(covered[Math.min(covered.length - 1, Math.floor((q / 100) * covered.length))] || 0,
-                         1 / 255);
-    map = (v) => v / top;
-    legend = `${formatNumber(top)} (${q}th percentile; brighter pixels clamped)`;
-  }
-  values.forEach((v, k) => {
-    if (v < 0) return;
-    const rgb = heatRamp(map(v));
-    for (let c = 0; c < 3; c++) data[4 * k + c] = Math.round(rgb[c] * 255);
-  });
-  ctx.putImageData(pixels, 0, 0);
-  $("diff-scale").textContent = legend;
+  const { url, top } = await rescaleDiff(imageUrl(image), scale, mode);
+  $("diff-scale").textContent = mode === "log"
+      ? `${formatNumber(scale)} (logarithmic from ${formatNumber(LOG_FLOOR)})`
+      : `${formatNumber(top)} (${mode}th percentile; brighter pixels clamped)`;
   return new Promise((resolve) => {
     $("diff").onload = $("diff").onerror = () => resolve();
-    $("diff").src = canvas.toDataURL("image/png");
+    $("diff").src = url;
   });
-}
-
-// ---------------------------------------------------------------- metrics table
-
-function formatNumber(x) {
-  if (x === undefined || x === null) return "–";
-  if (Number.isInteger(x)) return x.toLocaleString("en");
-  const a = Math.abs(x);
-  return a !== 0 && (a < 1e-3 || a >= 1e6) ? x.toExponential(2) : x.toPrecision(4);
-}
-
-// [good, suspicious]: a value on the good side of the first is coloured good, one past the
-// second suspicious (for "higher is better" rows the bounds decrease). Rough guides for a
-// picture of a few hundred pixels, not verdicts.
-const below = (good, suspicious) => (x) => (x <= good ? "good" : x > suspicious ? "suspicious" : "");
-const above = (good, suspicious) => (x) => (x >= good ? "good" : x < suspicious ? "suspicious" : "");
-
-function fillMetrics(answer) {
-  const m = answer.metrics, s = answer.stats, t = answer.timings;
-  // [name, value, one-line explanation, judge]; a row with value null starts a table.
-  const rows = [
-    ["silhouette", null],
-    ["outline Hausdorff (px)", m.silhouette?.outlineHausdorffPx,
-     "The farthest any point of the approximation's outline lies from the reference's outline " +
-     "(continuous curves, in pixels). Under 1 px the outlines look the same.", below(1, 2)],
-    ["outline mean (px)", m.silhouette?.outlineMeanPx,
-     "The average distance between the two outlines, in pixels.", below(0.5, 1)],
-    ["mask Hausdorff (px)", m.silhouette?.hausdorffPx,
-     "The same farthest distance measured on the covered-pixel masks (supersampled).", below(1, 2)],
-    ["IoU", m.silhouette?.iou,
-     "Covered pixels in both divided by covered pixels in either: 1 is the same coverage.",
-     above(0.995, 0.98)],
-    ["mismatched pixels", m.silhouette?.mismatchPx,
-     "Pixels covered by one of the two pictures but not the other."],
-    ["image, depth, normals", null],
-    ["colour RMSE", m.image?.rmse,
-     "Root-mean-square colour difference (0..1 per channel) over the covered pixels.",
-     below(0.01, 0.04)],
-    ["PSNR (dB)", m.image?.psnr,
-     "Peak signal-to-noise ratio of the colour: above 40 dB differences are hard to see.",
-     above(40, 30)],
-    ["diff scale (top of ramp)", m.image?.diffScale,
-     "The largest colour difference of one pixel: the top (pale yellow) of the difference image."],
-    ["depth max (rel.)", m.depth?.maxRel,
-     "The largest depth difference at a pixel covered by both, relative to the depth.",
-     below(0.01, 0.05)],
-    ["normal mean (deg)", m.normal?.meanDeg,
-     "The average angle between the approximation's and the limit's normals over the pixels " +
-     "both cover: what shading errors come from.", below(1, 5)],
-    ["normal max (deg)", m.normal?.maxDeg,
-     "The largest normal angle at one pixel; large at a few pixels along the outline is common " +
-     "(one picture sees the front, the other the back), so read it with the mean."],
-    ["geometry max dist (rel.)", m.geometry?.relMaxDist,
-     "The largest distance from the approximation's vertices to the limit surface, relative to " +
-     "the bounding-box diagonal.", below(0.001, 0.01)],
-    ["size", null],
-    ["triangles", s.triangles, "Triangles of the approximation."],
-    ["reference triangles", s.referenceTriangles, "Triangles of the reference's mesh, if any."],
-    ["times (ms)", null],
-    ["surface", t.surfaceMs, "Building the limit surface (topology, patch tables)."],
-    ["approximation", t.approxMs, "Making the approximation's triangles."],
-    ["raster", t.rasterMs, "Drawing the pictures."],
-    ["reference", t.referenceMs, "Ray casting the exact limit surface."],
-    ["metrics", t.metricsMs, "Comparing the two."],
-    ["encode", t.encodeMs, "Writing the PNG images."],
-    ["total", t.totalMs, "The server's whole time for the request."],
-  ];
-  // One small table per group, side by side.
-  const tables = [];
-  for (const [name, value, explanation, judge] of rows) {
-    if (value === null) {
-      const table = document.createElement("table");
-      table.createCaption().textContent = name;
-      tables.push(table);
-      continue;
-    }
-    const tr = tables.at(-1).insertRow();
-    const label = tr.insertCell();
-    label.textContent = name;
-    label.title = explanation;
-    const cell = tr.insertCell();
-    cell.textContent = formatNumber(value);
-    cell.title = explanation;
-    const verdict = judge && typeof value === "number" ? judge(value) : "";
-    if (verdict) cell.className = verdict;
-  }
-  $("metrics").replaceChildren(...tables);
 }
 
 // ---------------------------------------------------------------- the cage without the surface
