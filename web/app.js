@@ -72,6 +72,11 @@ const state = {
   turntableTimer: null,  // the interval that plays a turntable's views
   scene: null,          // an implicit scene ({field, ...}: a /v1/implicit request) instead of a mesh
   uploads: 0,           // mesh uploads in flight
+  diff: null,           // {image, scale}: the last answer's difference image and its top
+  restoring: null,      // an address's parameters, applied once the first mesh is chosen
+  shownExample: null,   // the example and scheme of the last picture (a refused upload's way back)
+  shownScheme: null,
+  dragging: false,
 };
 
 // An implicit scene sent whole with every request; it stands where an UploadedMesh would.
