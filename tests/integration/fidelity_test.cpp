@@ -55,8 +55,8 @@ const std::filesystem::path& corpusDir() {
 }
 
 std::string meshJson(const std::string& objPath, const char* scheme = "catmull-clark") {
-  return R"({"format": "obj", "scheme": ")" + std::string(scheme) +
-         R"(", "data": )" + quoted(readFile(objPath)) + "}";
+  return R"({"format": "obj", "scheme": ")" + std::string(scheme) + R"(", "data": )" +
+         quoted(readFile(objPath)) + "}";
 }
 
 struct Measured {
@@ -90,8 +90,9 @@ const std::string kPawn = std::string(LIMN_SOURCE_DIR) + "/examples/pawn.obj";
 // surface and poked past the outline by 1.04 px at 1024^2, at any dicing rate.
 TEST(AdaptiveOutline, ChordsBehindAConcaveSilhouetteDoNotPokeOut) {
   ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
-  Measured m = render(server, meshJson(kPawn), R"("method": "adaptive", "params": {"dicingRate": 1})",
-                      R"({"width": 1024, "height": 1024})");
+  Measured m =
+      render(server, meshJson(kPawn), R"("method": "adaptive", "params": {"dicingRate": 1})",
+             R"({"width": 1024, "height": 1024})");
   ASSERT_EQ(m.status, 200) << m.body;
   EXPECT_LE(m.outlinePx, 0.5) << m.warnings;
 }
@@ -128,8 +129,7 @@ TEST(ReferenceAccuracy, AForcedBudgetIsReportedWithABoundThatHolds) {
   ASSERT_EQ(coarse.status, 200) << coarse.body;
 
   EXPECT_NEAR(exact.accuracyPx, 0.01, 1e-9);
-  EXPECT_EQ(exact.warnings.find("outline chord error raised"), std::string::npos)
-      << exact.warnings;
+  EXPECT_EQ(exact.warnings.find("outline chord error raised"), std::string::npos) << exact.warnings;
   EXPECT_GT(coarse.accuracyPx, 0.05);
   EXPECT_NE(coarse.warnings.find("outline chord error raised"), std::string::npos)
       << coarse.warnings;
@@ -138,17 +138,19 @@ TEST(ReferenceAccuracy, AForcedBudgetIsReportedWithABoundThatHolds) {
             coarse.accuracyPx + exact.accuracyPx + 1e-3)
       << "exact " << exact.outlinePx << " px, starved " << coarse.outlinePx << " px (accuracy "
       << coarse.accuracyPx << ")";
-  std::printf("reference budget | full: %.4f px (accuracy %.3f) | 20000 triangles: %.4f px "
-              "(accuracy %.3f)\n",
-              exact.outlinePx, exact.accuracyPx, coarse.outlinePx, coarse.accuracyPx);
+  std::printf(
+      "reference budget | full: %.4f px (accuracy %.3f) | 20000 triangles: %.4f px "
+      "(accuracy %.3f)\n",
+      exact.outlinePx, exact.accuracyPx, coarse.outlinePx, coarse.accuracyPx);
 }
 
 // An outline distance within the reference's accuracy is flagged, not reported as if exact.
 TEST(ReferenceAccuracy, ADistanceWithinTheReferencesAccuracyIsFlagged) {
   ServerProcess starved =
       ServerProcess::withConfig(R"({"workers": 1, "limits": {"maxReferenceTriangles": 20000}})");
-  Measured m = render(starved, meshJson(kPawn), R"("method": "adaptive", "params": {"dicingRate": 1})",
-                      R"({"width": 512, "height": 512})");
+  Measured m =
+      render(starved, meshJson(kPawn), R"("method": "adaptive", "params": {"dicingRate": 1})",
+             R"({"width": 512, "height": 512})");
   ASSERT_EQ(m.status, 200) << m.body;
   ASSERT_LE(m.outlinePx, m.accuracyPx) << "this case needs a distance under the accuracy";
   EXPECT_NE(m.warnings.find("within the reference's own accuracy"), std::string::npos)

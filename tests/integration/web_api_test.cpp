@@ -80,7 +80,8 @@ TEST_F(WebServer, ServesThePageItsScriptsAndStyle) {
   EXPECT_EQ(page.header("Content-Type"), "text/html; charset=utf-8");
   EXPECT_NE(page.body.find(R"(<script type="module" src="/app.js">)"), std::string::npos);
   EXPECT_EQ(get(port(), "/index.html").body, page.body);
-  for (const char* path : {"/app.js", "/api.js", "/glview.js"}) {
+  for (const char* path :
+       {"/app.js", "/api.js", "/glview.js", "/layout.js", "/metrics.js", "/diff.js"}) {
     HttpResponse script = get(port(), path);
     EXPECT_EQ(script.status, 200) << path;
     EXPECT_EQ(script.header("Content-Type"), "text/javascript; charset=utf-8") << path;
@@ -89,7 +90,8 @@ TEST_F(WebServer, ServesThePageItsScriptsAndStyle) {
   EXPECT_EQ(style.status, 200);
   EXPECT_EQ(style.header("Content-Type"), "text/css; charset=utf-8");
   // Nothing the page loads comes from another origin (it works offline).
-  for (const char* path : {"/", "/app.js", "/api.js", "/glview.js", "/style.css"}) {
+  for (const char* path : {"/", "/app.js", "/api.js", "/glview.js", "/layout.js", "/metrics.js",
+                           "/diff.js", "/style.css"}) {
     EXPECT_EQ(get(port(), path).body.find("://"), std::string::npos) << path;
   }
   HttpResponse wrongMethod = post(port(), "/", "{}");
