@@ -176,9 +176,9 @@ def box(mesh, centre, size, segments=(2, 2, 2), crease=0.0):
                     quad.append(point(*c))
                 mesh.add_face(quad[::-1] if flip else quad)
 
-    grid(0, 0, False), grid(0, nx, True)
-    grid(1, 0, True), grid(1, ny, False)
-    grid(2, 0, False), grid(2, nz, True)
+    grid(0, 0, True), grid(0, nx, False)  # faces wound counter-clockwise seen from outside
+    grid(1, 0, False), grid(1, ny, True)
+    grid(2, 0, True), grid(2, nz, False)
     if crease > 0:
         dims = [nx, ny, nz]
         for axis in range(3):
