@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/subdiv/closed_pieces.h"
 #include "render/subdiv/far_patch_surface.h"
 #include "render/subdiv/far_point.h"
 #include "render/subdiv/limit_surface.h"
@@ -93,8 +94,7 @@ PatchSet::PatchSet(const mesh::ControlMesh& mesh, int isolation, const CancelTok
   std::unique_ptr<Far::TopologyRefiner> refiner = subdiv::createTopologyRefiner(mesh);
   const Far::TopologyLevel& base = refiner->GetLevel(0);
   const std::vector<bool> onBoundary = facesOnTheBoundary(base);
-  closed_ = std::none_of(onBoundary.begin(), onBoundary.end(), [](bool b) { return b; });
-  for (int f = 0; f < base.GetNumFaces(); ++f) closed_ = closed_ && !base.IsFaceHole(f);
+  hiddenSide_ = subdiv::hiddenSideOfFaces(base, mesh.points);
   // Ptex faces (one per quad or triangle, one per corner of an n-gon) back to base faces.
   std::vector<std::pair<int, int>> ptexToFace;
   {

@@ -14,6 +14,7 @@
 #include <opensubdiv/far/stencilTable.h>
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -94,8 +95,10 @@ class PatchSet {
   const std::vector<Patch>& patches() const { return patches_; }
   const PatchTableStats& stats() const { return stats_; }
   mesh::Scheme scheme() const { return scheme_; }
-  // No boundary, non-manifold edge or hole: seen from outside, back-facing patches are hidden.
-  bool closed() const { return closed_; }
+  // Per base face, which side of it is hidden when seen from outside its piece: +1 / -1 on a
+  // closed piece wound outward / inward, 0 on an open one (subdiv/closed_pieces.h). Decided
+  // from the control points the set was made with (setControlPoints keeps it).
+  int hiddenSide(int baseFace) const { return hiddenSide_[baseFace]; }
   // The control points' bounds, widened by the displacement's reach: they hold the whole
   // surface (its points are convex combinations of the control points, then displaced).
   const Bounds& controlBounds() const { return controlBounds_; }
@@ -119,7 +122,7 @@ class PatchSet {
 
  private:
   mesh::Scheme scheme_;
-  bool closed_ = false;
+  std::vector<int8_t> hiddenSide_;
   Bounds controlBounds_;
   size_t controlPoints_ = 0;
   subdiv::Displacement displacement_;

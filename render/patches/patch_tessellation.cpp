@@ -410,12 +410,13 @@ class Tessellator {
     const std::vector<Patch>& patches = set_.patches();
     patchCulled_.assign(patches.size(), 0);
     if (!options_.cullHidden) return;
-    const bool backFacesHidden = set_.closed() && seenFromOutside();
+    const bool outside = seenFromOutside();
     parallelFor(patches.size(), 256, [&](size_t begin, size_t end) {
       for (size_t p = begin; p < end; ++p) {
         if (outsideTheView(set_, patches[p], camera_)) {
           patchCulled_[p] = 1;
-        } else if (backFacesHidden && facesAwayEverywhere(set_, patches[p], camera_)) {
+        } else if (const int side = set_.hiddenSide(patches[p].baseFace);
+                   outside && side != 0 && facesAwayEverywhere(set_, patches[p], camera_, side)) {
           patchCulled_[p] = 2;
         }
       }
@@ -744,7 +745,8 @@ std::vector<Vec3> differences(const std::vector<Vec3>& points, const PointPairs&
 
 }  // namespace
 
-bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& camera) {
+bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& camera,
+                         int hiddenSide) {
   if (!patch.cullable) return false;
   const std::vector<Vec3> p = set.controlPoints(patch);
   const bool loop = patch.type == OpenSubdiv::Far::PatchDescriptor::LOOP;
@@ -760,7 +762,7 @@ bool facesAwayEverywhere(const PatchSet& set, const Patch& patch, const Camera& 
   for (const Vec3& a : ds) {
     for (const Vec3& b : dt) sum += cross(a, b);
   }
-  const double orientation = dot(sum, centreNormal) < 0 ? -1.0 : 1.0;
+  const double orientation = (dot(sum, centreNormal) < 0 ? -1.0 : 1.0) * hiddenSide;
 
   Vec3 centre{0, 0, 0};
   for (const Vec3& q : p) centre += q / static_cast<double>(p.size());

@@ -113,6 +113,8 @@ bool outsideTheView(const PatchSet& patches, const Patch& patch, const Camera& c
 
 // True when `patch` is regular and every normal its B-spline points allow faces away from the
 // eye (for each point the patch may cover): it cannot be seen from outside a closed surface.
-bool facesAwayEverywhere(const PatchSet& patches, const Patch& patch, const Camera& camera);
+// hiddenSide -1 (an inside-out piece, PatchSet::hiddenSide): the normals are taken reversed.
+bool facesAwayEverywhere(const PatchSet& patches, const Patch& patch, const Camera& camera,
+                         int hiddenSide = 1);
 
 }  // namespace limn::render::patches

@@ -19,9 +19,11 @@ int segmentsFor(double sagPx, const ChordOptions& options) {
 }
 
 // How far `chordPoint` lies outside the surface at `sample`, in pixels (0 when inside).
+// `outward`: -1 on a piece wound inside-out (LimitSurface::hiddenSide), whose limit normals point
+// in; else 1.
 double outsidePixels(const Camera& camera, const Vec3& chordPoint,
-                     const subdiv::LimitSample& sample) {
-  if (dot(chordPoint - sample.position, sample.normal) <= 0) return 0;
+                     const subdiv::LimitSample& sample, int outward) {
+  if (outward * dot(chordPoint - sample.position, sample.normal) <= 0) return 0;
   Vec3 a = camera.project(chordPoint), b = camera.project(sample.position);
   return std::hypot(a.x - b.x, a.y - b.y);
 }
@@ -37,7 +39,7 @@ void sortByT(std::vector<EdgePoint>& points) {
 // not, with at most options.maxSegments points on the edge. True when it added any.
 template <typename Evaluate>
 bool halveOutsideSegments(const Camera& camera, const Vec3& first, const Vec3& last,
-                          const Evaluate& at, const ChordOptions& options,
+                          const Evaluate& at, int outward, const ChordOptions& options,
                           std::vector<EdgePoint>& points) {
   bool added = false;
   for (size_t i = 0; i <= points.size();) {
@@ -48,7 +50,8 @@ bool halveOutsideSegments(const Camera& camera, const Vec3& first, const Vec3& l
     const Vec3& p1 = i == points.size() ? last : points[i].position;
     const double t = 0.5 * (t0 + t1);
     const subdiv::LimitSample middle = at(t);
-    if (t1 - t0 < 1e-4 || outsidePixels(camera, 0.5 * (p0 + p1), middle) <= options.tolerancePx) {
+    if (t1 - t0 < 1e-4 ||
+        outsidePixels(camera, 0.5 * (p0 + p1), middle, outward) <= options.tolerancePx) {
       ++i;
       continue;
     }
@@ -120,8 +123,10 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
       auto at = [&](double t) {
         return domains.evaluate(owner, edgeUV(domains, owner, static_cast<int>(e), t));
       };
+      const int outward = surface.hiddenSide(owner) < 0 ? -1 : 1;
       int segments = segmentsFor(
-          outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), at(0.5)), options);
+          outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), at(0.5), outward),
+          options);
       if (segments >= 2) {
         out.edgeRates[e] = segments;
         for (int i = 1; i < segments; ++i) {
@@ -130,7 +135,8 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
         }
         sortByT(points);
       }
-      if (halveOutsideSegments(camera, limit[ends[0]], limit[ends[1]], at, options, points)) {
+      if (halveOutsideSegments(camera, limit[ends[0]], limit[ends[1]], at, outward, options,
+                               points)) {
         out.edgeRates[e] = std::max(out.edgeRates[e], 2);
       }
     }
@@ -144,8 +150,9 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
     Far::ConstIndexArray verts = base.GetFaceVertices(f);
     for (int v : verts) centroid += limit[v];
     centroid = centroid / static_cast<double>(verts.size());
-    int rate = segmentsFor(outsidePixels(camera, centroid, domains.evaluate(f, domains.center(f))),
-                           options);
+    const int outward = surface.hiddenSide(f) < 0 ? -1 : 1;
+    int rate = segmentsFor(
+        outsidePixels(camera, centroid, domains.evaluate(f, domains.center(f)), outward), options);
     for (int e : base.GetFaceEdges(f)) rate = std::max(rate, out.edgeRates[e]);
     if (rate < 2) continue;
     out.interiorRates[f] = rate;

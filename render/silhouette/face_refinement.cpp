@@ -56,7 +56,9 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
     for (size_t i = 0; i + 1 < chain.size(); ++i) locked.insert(key(chain[i], chain[i + 1]));
   }
 
-  // How far the chord a-b lies outside the surface at its middle, in pixels (0 if inside).
+  // How far the chord a-b lies outside the surface at its middle, in pixels (0 if inside); the
+  // limit normals of an inside-out piece point in.
+  const int outward = domains.surface().hiddenSide(face) < 0 ? -1 : 1;
   auto sag = [&](int a, int b, FacePoint* middle) {
     const FacePoint& pa = points[a];
     const FacePoint& pb = points[b];
@@ -64,7 +66,7 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
     subdiv::LimitSample s = domains.evaluate(face, uv);
     *middle = {uv, s.position, s.normal};
     Vec3 chord = 0.5 * (pa.position + pb.position);
-    if (dot(chord - s.position, s.normal) <= 0) return 0.0;
+    if (outward * dot(chord - s.position, s.normal) <= 0) return 0.0;
     Vec3 c = camera.project(chord), m = camera.project(s.position);
     return std::hypot(c.x - m.x, c.y - m.y);
   };

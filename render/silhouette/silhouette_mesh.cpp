@@ -86,24 +86,11 @@ int loopRate(const FaceDomains& domains, const Camera& camera, int face) {
   return std::clamp(static_cast<int>(std::ceil(span / kLoopSegmentPx)), 4, kMaxLoopRate);
 }
 
-// True when the surface is closed: no boundary or non-manifold edge, no hole. A ray's first hit
-// on a closed surface enters it, so what faces away from the eye is never seen there.
-bool isClosed(const subdiv::LimitSurface& surface) {
-  const Far::TopologyLevel& base = surface.baseLevel();
-  for (int f = 0; f < surface.faceCount(); ++f) {
-    if (!surface.hasLimit(f)) return false;
-  }
-  for (int e = 0; e < base.GetNumEdges(); ++e) {
-    if (base.IsEdgeBoundary(e) || base.IsEdgeNonManifold(e)) return false;
-  }
-  return true;
-}
-
-// Leaves out triangles that cannot be seen. On a closed surface, every triangle that faces away
-// from the eye: it is hidden there, but its flat chord lies on the eye's side of the true
-// surface, so next to an inner contour it could poke through the front's chords, which lie
-// behind it (the dark fringes of back faces along a fold). A corner faces away when the cosine
-// between its limit normal and the view ray is above kBackFacingCos; corners on the contour
+// Leaves out triangles that cannot be seen. On a closed piece (LimitSurface::hiddenSide), every
+// triangle that faces away from the eye: it is hidden there, but its flat chord lies on the eye's
+// side of the true surface, so next to an inner contour it could poke through the front's chords,
+// which lie behind it (the dark fringes of back faces along a fold). A corner faces away when the
+// cosine between its limit normal and the view ray is above kBackFacingCos; corners on the contour
 // (cosine about 0) do not say which side a triangle is on, so a triangle with no corner facing
 // the eye is decided by its (u, v) centre.
 // On any surface, open ones too, a triangle whose three corners lie on the contour curve and
@@ -112,11 +99,12 @@ bool isClosed(const subdiv::LimitSurface& surface) {
 // curved strip seen edge-on) its chord spans the concavity and stands pixels past the outline.
 constexpr double kBackFacingCos = 1e-3;
 
-size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, bool closed,
-                  FacePiece& piece) {
+size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, FacePiece& piece) {
+  const int hiddenSide = domains.surface().hiddenSide(face);
+  const bool closed = hiddenSide != 0;
   auto facing = [&](const Vec3& position, const Vec3& normal) {
-    const double cosine =
-        contourFunction(camera, position, normal) / length(camera.viewVector(position));
+    const double cosine = (closed ? hiddenSide : 1) * contourFunction(camera, position, normal) /
+                          length(camera.viewVector(position));
     return cosine > kBackFacingCos ? 1 : cosine < -kBackFacingCos ? -1 : 0;
   };
   std::vector<int> side(piece.points.size());
@@ -139,10 +127,8 @@ size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, bo
   return before - piece.triangles.size();
 }
 
-// `closed`: isClosed(surface), for cullHidden.
 FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const ContourSearch& search,
-                    const ChordRefinement& chords, const SilhouetteOptions& options, bool closed,
-                    int face) {
+                    const ChordRefinement& chords, const SilhouetteOptions& options, int face) {
   const subdiv::LimitSurface& surface = domains.surface();
   FacePiece piece;
   FaceBoundary boundary = faceBoundary(domains, search, face);
@@ -214,7 +200,7 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
       chains.push_back(std::move(chain));
     }
     // Hidden triangles go first, so that none is split only to be left out.
-    if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, closed, piece);
+    if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, piece);
     piece.splits =
         refineFaceTriangles(domains, camera, face, static_cast<int>(boundary.points.size()), chains,
                             options.chords.tolerancePx,
@@ -242,7 +228,6 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
   out.stats.refinedFaces = chords.refinedFaces;
 
   const int faceCount = surface.faceCount();
-  const bool closed = isClosed(surface);
   std::vector<FacePiece> pieces(faceCount);
   parallelFor(faceCount, 32, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
@@ -250,9 +235,9 @@ SilhouetteMesh buildSilhouetteMesh(const subdiv::LimitSurface& surface, const Ca
       if (!surface.hasLimit(static_cast<int>(f))) continue;
       FacePiece& piece = pieces[f];
       const int face = static_cast<int>(f);
-      piece = buildFace(domains, camera, out.search, chords, options, closed, face);
+      piece = buildFace(domains, camera, out.search, chords, options, face);
       // Again after buildFace: it culls only the faces it splits, and before the splits.
-      if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, closed, piece);
+      if (options.cullHidden) piece.culled += cullHidden(domains, camera, face, piece);
     }
   });
   cancel.check();

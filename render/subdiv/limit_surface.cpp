@@ -11,6 +11,7 @@
 #include <string>
 
 #include "render/core/error.h"
+#include "render/subdiv/closed_pieces.h"
 #include "render/subdiv/far_patch_surface.h"
 
 namespace limn::render::subdiv {
@@ -184,6 +185,7 @@ void LimitSurface::build(const CancelToken& cancel) const {
   cancel.check();
   buildFaceSurfaces(farPatchFaces, cancel);
   computeControlLimits(cancel);
+  hiddenSide_ = hiddenSideOfFaces(baseLevel(), mesh_.points);
 }
 
 LimitSurface::~LimitSurface() = default;

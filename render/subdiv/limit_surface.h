@@ -21,6 +21,7 @@
 #include <opensubdiv/far/topologyRefiner.h>
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -105,6 +106,12 @@ class LimitSurface {
     prepare();
     return faces_[face].valid;
   }
+  // +1 / -1: the face is on a closed piece wound outward / inward, whose side facing away from
+  // the eye (by the limit normal, times this) is hidden; 0: on an open piece (closed_pieces.h).
+  int hiddenSide(int face) const {
+    prepare();
+    return hiddenSide_[face];
+  }
   // True when the face is evaluated through Far's patch table rather than Bfr.
   bool onFarPatches(int face) const {
     prepare();
@@ -158,6 +165,7 @@ class LimitSurface {
   mutable std::recursive_mutex prepareMutex_;
   mutable bool building_ = false;
   mutable std::vector<FaceData> faces_;
+  mutable std::vector<int8_t> hiddenSide_;  // per face, see hiddenSide()
   mutable std::vector<FaceSurface> surfaces_;
   mutable std::unique_ptr<FarPatchSurface> farPatches_;  // only when some face needs it
   mutable std::vector<Vec3> controlLimitPositions_;

@@ -63,17 +63,8 @@ struct FacePatch {
   int boundaryCount = 0;
 };
 
-bool isClosed(const subdiv::LimitSurface& surface) {
-  if (!surface.mesh().holes.empty()) return false;
-  const Far::TopologyLevel& base = surface.baseLevel();
-  for (int e = 0; e < base.GetNumEdges(); ++e) {
-    if (base.GetEdgeFaces(e).size() != 2) return false;
-  }
-  return true;
-}
-
 FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera& camera,
-                    bool closed) {
+                    int hiddenSide) {
   FaceProbe probe;
   Bfr::Parameterization param = surface.parameterization(face);
   const int n = param.GetFaceSize();
@@ -83,7 +74,8 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
 
   std::vector<Vec3> pixel(2 * n), position(2 * n);
   const double margin = 0.05 * std::max(camera.width(), camera.height());
-  bool anyInFront = false, anyFacing = false, anyFacingAway = false;
+  // Facing the eye or away by the limit normal, which follows the winding.
+  bool anyInFront = false, anyTowards = false, anyAway = false;
   double nearestEdgeOn = 1;  // the smallest |cosine| between a probe's normal and its view ray
   double turn = 0;           // the largest angle between the first probe's normal and another's
   Vec3 firstNormal;
@@ -92,8 +84,8 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
     subdiv::LimitSample s = surface.evaluate(face, uv[2 * i], uv[2 * i + 1]);
     Vec3 view = camera.viewVector(s.position);
     const double facing = dot(s.normal, view) / std::max(length(view), 1e-300);
-    if (facing < 1e-3) anyFacing = true;
-    if (facing > -1e-3) anyFacingAway = true;
+    if (facing < 1e-3) anyTowards = true;
+    if (facing > -1e-3) anyAway = true;
     nearestEdgeOn = std::min(nearestEdgeOn, std::abs(facing));
     if (i == 0) firstNormal = s.normal;
     turn = std::max(turn,
@@ -119,9 +111,12 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
       !anyInFront || (!partlyBehind && (maxX < -margin || minX > camera.width() + margin ||
                                         maxY < -margin || minY > camera.height() + margin));
   const bool nearEdgeOn =
-      (anyFacing && anyFacingAway) ||
+      (anyTowards && anyAway) ||
       nearestEdgeOn < std::sin(std::min(turn / 2, std::numbers::pi / 2)) + kCullMarginCosine;
-  probe.culled = outside || (closed && !anyFacing && !nearEdgeOn);
+  // On a closed piece the side away from the eye is hidden; an inside-out piece's limit normals
+  // point in, so its hidden side is the one they call "towards".
+  const bool allHidden = hiddenSide > 0 ? !anyTowards : hiddenSide < 0 && !anyAway;
+  probe.culled = outside || (allHidden && !nearEdgeOn);
   probe.edgePixels.resize(n);
   for (int k = 0; k < n; ++k) {
     const Vec3& a = pixel[2 * k];
@@ -131,7 +126,7 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
       probe.edgePixels[k] = 1e300;  // crosses the eye plane: as fine as allowed
     } else {
       probe.edgePixels[k] = std::hypot(m.x - a.x, m.y - a.y) + std::hypot(b.x - m.x, b.y - m.y);
-      if (anyFacing && anyFacingAway) {
+      if (anyTowards && anyAway) {
         probe.edgePixels[k] = std::max(
             probe.edgePixels[k], unforeshortenedPixels(camera, position[2 * k], position[2 * k + 1],
                                                        position[(2 * k + 2) % (2 * n)]));
@@ -267,7 +262,6 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
                                 const AdaptiveOptions& options, const CancelToken& cancel) {
   const Far::TopologyLevel& base = surface.baseLevel();
   const int faceCount = surface.faceCount();
-  const bool closed = isClosed(surface);
 
   // 1. Probe faces.
   std::vector<FaceProbe> probes(faceCount);
@@ -275,7 +269,8 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
     cancel.check();
     for (size_t f = begin; f < end; ++f) {
       if (surface.hasLimit(static_cast<int>(f))) {
-        probes[f] = probeFace(surface, static_cast<int>(f), camera, closed);
+        probes[f] = probeFace(surface, static_cast<int>(f), camera,
+                              surface.hiddenSide(static_cast<int>(f)));
       }
     }
   });

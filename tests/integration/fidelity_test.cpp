@@ -6,11 +6,14 @@
 #include <gtest/gtest.h>
 #include <rapidjson/document.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "tests/integration/http_client.h"
 #include "tests/integration/json_answer.h"
@@ -27,7 +30,7 @@ std::string readFile(const std::filesystem::path& path) {
 }
 
 // JSON string literal of `text` (OBJ text: newlines, no quotes or backslashes).
-std::string quoted(const std::string& text) {
+std::string jsonString(const std::string& text) {
   std::string out = "\"";
   for (char c : text) {
     if (c == '\n') {
@@ -56,13 +59,14 @@ const std::filesystem::path& corpusDir() {
 
 std::string meshJson(const std::string& objPath, const char* scheme = "catmull-clark") {
   return R"({"format": "obj", "scheme": ")" + std::string(scheme) + R"(", "data": )" +
-         quoted(readFile(objPath)) + "}";
+         jsonString(readFile(objPath)) + "}";
 }
 
 struct Measured {
   int status = 0;
   double outlinePx = -1;
   double accuracyPx = -1;
+  uint64_t triangles = 0;
   std::string warnings;
   std::string body;
 };
@@ -79,6 +83,7 @@ Measured render(const ServerProcess& server, const std::string& mesh, const std:
   rapidjson::Document doc = parseJson(r.body);
   m.outlinePx = doc["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble();
   m.accuracyPx = doc["reference"]["accuracyPx"].GetDouble();
+  m.triangles = doc["stats"]["triangles"].GetUint64();
   for (const auto& w : doc["warnings"].GetArray()) m.warnings += std::string(w.GetString()) + "\n";
   return m;
 }
@@ -109,6 +114,43 @@ TEST(AdaptiveOutline, EdgesSeenEndOnAtASilhouetteAreDicedAsIfFaceOn) {
           "fovYDeg": 41.2249182, "width": 512, "height": 512})");
   ASSERT_EQ(m.status, 200) << m.body;
   EXPECT_LE(m.outlinePx, 0.5) << m.warnings;
+}
+
+// Pieces wound inside-out (every face clockwise seen from outside: their limit normals point
+// in), common in production models. The methods cull the side of a closed piece that faces away
+// from the eye, and the silhouette method's concave correction asks which side of the surface
+// a chord lies on; both read the normal, so an inside-out humanoid was drawn with its visible
+// side taken for hidden: the silhouette method 2.19 px off with 6x the triangles (0.44 px
+// wound outward). Each closed piece's winding is now read from its enclosed volume.
+TEST(ClosedPieces, AnInsideOutModelIsDrawnAsWellAsTheSameModelWoundOutward) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  const std::string outward = readFile(corpusDir() / "humanoid.obj");
+  std::string insideOut;
+  std::istringstream lines(outward);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("f ", 0) == 0) {
+      std::istringstream corners(line.substr(2));
+      std::vector<std::string> v{std::istream_iterator<std::string>(corners), {}};
+      line = "f";
+      for (auto it = v.rbegin(); it != v.rend(); ++it) line += " " + *it;
+    }
+    insideOut += line + "\n";
+  }
+  const std::string camera =
+      R"({"eye": [-0.0461363, 0.1280192, 4.6157623], "target": [0, 0.419, 0], "up": [0, 1, 0],
+          "fovYDeg": 41.2249182, "width": 512, "height": 512})";
+  for (const char* method :
+       {R"("method": "silhouette")", R"("method": "adaptive", "params": {"dicingRate": 1})",
+        R"("method": "patches", "params": {"dicingRate": 1})"}) {
+    const std::string mesh = R"({"format": "obj", "data": )";
+    Measured out = render(server, mesh + jsonString(outward) + "}", method, camera);
+    Measured in = render(server, mesh + jsonString(insideOut) + "}", method, camera);
+    ASSERT_EQ(out.status, 200) << out.body;
+    ASSERT_EQ(in.status, 200) << in.body;
+    EXPECT_NEAR(in.outlinePx, out.outlinePx, 0.05) << method;
+    EXPECT_LE(in.triangles, out.triangles * 11 / 10) << method;
+    EXPECT_LE(in.outlinePx, 1.0) << method;
+  }
 }
 
 // The reference never hides its own error: a server whose reference budget is too small for

@@ -415,6 +415,32 @@ TEST(LimitSurface, CreasedNonManifoldVerticesAreOnFarPatchesNotBfrsBrokenPath) {
   for (int f = 0; f < cube.faceCount(); ++f) EXPECT_FALSE(surface.onFarPatches(f)) << f;
 }
 
+// Closed pieces and their winding (closed_pieces.h): a cube wound outward hides the side its
+// limit normals point away from the eye (+1), the same cube wound inward the other (-1); a
+// piece with a boundary hides nothing (0), even beside a closed one.
+TEST(LimitSurface, HiddenSideFollowsEachPiecesClosureAndWinding) {
+  mesh::ControlMesh outward = testing::cube();
+  mesh::ControlMesh inward = outward;
+  for (int f = 0, first = 0; f < inward.faceCount(); first += inward.faceVertexCounts[f++]) {
+    std::reverse(inward.faceVertexIndices.begin() + first,
+                 inward.faceVertexIndices.begin() + first + inward.faceVertexCounts[f]);
+  }
+  mesh::ControlMesh both = outward;  // the cube and, apart from it, an open quad
+  const int base = static_cast<int>(both.points.size());
+  both.points.insert(both.points.end(), {{3, 0, 0}, {4, 0, 0}, {4, 1, 0}, {3, 1, 0}});
+  testing::addFace(both, {base, base + 1, base + 2, base + 3});
+  LimitSurface out(outward), in(inward), mixed(both);
+  for (int f = 0; f < outward.faceCount(); ++f) {
+    EXPECT_EQ(out.hiddenSide(f), 1) << f;
+    EXPECT_EQ(in.hiddenSide(f), -1) << f;
+    EXPECT_EQ(mixed.hiddenSide(f), 1) << f;
+    // The limit normal points out of the outward cube: +1 means "normal away from the eye".
+    const LimitSample s = out.evaluate(f, 0.5, 0.5);
+    EXPECT_GT(dot(s.normal, s.position), 0) << f;
+  }
+  EXPECT_EQ(mixed.hiddenSide(both.faceCount() - 1), 0);
+}
+
 // The corpus shape made for this case (skipped without ../shared/corpus): nine shapes with
 // interior valence-2 vertices next to creases, boundaries and n-gons.
 TEST(LimitSurface, EvaluatesTheCorpusValenceTwoShape) {
