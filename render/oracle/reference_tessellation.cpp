@@ -98,11 +98,14 @@ void fitToBudget(const std::vector<FaceProbe>& probes, const std::vector<char>& 
   while (result.dicingRate < kReferenceMaxDicingRate && estimate() > budget) {
     result.dicingRate = std::min(result.dicingRate * 1.5, kReferenceMaxDicingRate);
   }
-  for (int step = 0; step < 8; ++step) {  // the interior's share stays: a few steps converge
-    const double over = estimate() / budget;
-    if (over <= 1.0) break;
-    result.outlineErrorPx *= over * 1.05;
-  }
+  // One step, by the whole excess: segments go as 1 / sqrt(error) until an edge reaches one
+  // segment or the rate cap. Iterating to meet the budget exactly would chase the faces no error
+  // can shrink (coincident vertices make a face's sampled curvature unbounded, so its edges stay
+  // at the cap) and end with every other outline edge at one segment (a fern's degenerate
+  // leaflet tips took its reference to 1.9 px); the tessellator's own fit (ratesScaled) keeps
+  // what is left within four times the budget.
+  const double over = estimate() / budget;
+  if (over > 1.0) result.outlineErrorPx *= over;
 }
 
 }  // namespace
@@ -117,10 +120,12 @@ ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface
 
   fitToBudget(probes, outline, triangleBudget, result);
 
-  // Segments per edge; where the rate cap cuts them short, the error grows as 1 / rate^2.
+  // Segments per edge, and the chord error they leave (where the rate cap cuts them short it
+  // grows as 1 / rate^2). No segment stands further from its curve than half its own length,
+  // which bounds the edges of degenerate faces, whose sampled curvature is unbounded.
   const Far::TopologyLevel& base = surface.baseLevel();
   std::vector<int> segments(base.GetNumEdges(), 0);
-  double achieved = result.outlineErrorPx;
+  double achieved = kOutlineChordErrorPx;
   for (int f = 0; f < surface.faceCount(); ++f) {
     if (!outline[f]) continue;
     ++result.outlineFaces;
@@ -129,7 +134,8 @@ ReferenceTessellation tessellateForReference(const subdiv::LimitSurface& surface
       double needed = probes[f].segmentsAtOnePixel[k] / std::sqrt(result.outlineErrorPx);
       double rate = clampRate(needed);
       double perSegment = probes[f].segmentsAtOnePixel[k] / rate;
-      achieved = std::max(achieved, perSegment * perSegment);
+      achieved =
+          std::max(achieved, std::min(perSegment * perSegment, 0.5 * probes[f].lengthPx[k] / rate));
       segments[edges[k]] = std::max(segments[edges[k]], static_cast<int>(rate));
     }
   }

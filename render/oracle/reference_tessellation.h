@@ -40,7 +40,7 @@ inline constexpr double kReferenceTriangleBudget = 3e6;
 struct ReferenceTessellation {
   tessellate::TriangleMesh mesh;
   size_t outlineFaces = 0;    // faces whose edges were refined for an outline
-  double outlineErrorPx = 0;  // the chord error aimed for at outlines (output pixels)
+  double outlineErrorPx = 0;  // the chord error its outline edges keep to (output pixels)
   double dicingRate = 0;      // the edge length aimed for elsewhere (output pixels)
   // Per control face: it borders a boundary, a hole or a face without limit surface, so its
   // outline can run along its edges whatever the facing (the reference's mask refines there).
