@@ -178,6 +178,7 @@ void LimitSurface::prepare(const CancelToken& cancel) const {
 }
 
 void LimitSurface::build(const CancelToken& cancel) const {
+  hiddenSide_ = hiddenSideOfFaces(baseLevel(), mesh_.points);
   std::vector<int> farPatchFaces = facesBfrCannotEvaluate();
   farPatchFaces.insert(farPatchFaces.end(), alsoOnFarPatches_.begin(), alsoOnFarPatches_.end());
   std::sort(farPatchFaces.begin(), farPatchFaces.end());
@@ -185,7 +186,6 @@ void LimitSurface::build(const CancelToken& cancel) const {
   cancel.check();
   buildFaceSurfaces(farPatchFaces, cancel);
   computeControlLimits(cancel);
-  hiddenSide_ = hiddenSideOfFaces(baseLevel(), mesh_.points);
 }
 
 LimitSurface::~LimitSurface() = default;
