@@ -19,8 +19,7 @@ int segmentsFor(double sagPx, const ChordOptions& options) {
 }
 
 // How far `chordPoint` lies outside the surface at `sample`, in pixels (0 when inside).
-// `outward`: -1 on a piece wound inside-out (LimitSurface::hiddenSide), whose limit normals point
-// in; else 1.
+// `outward`: LimitSurface::outwardSign of the sample's face.
 double outsidePixels(const Camera& camera, const Vec3& chordPoint,
                      const subdiv::LimitSample& sample, int outward) {
   if (outward * dot(chordPoint - sample.position, sample.normal) <= 0) return 0;
@@ -123,10 +122,9 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
       auto at = [&](double t) {
         return domains.evaluate(owner, edgeUV(domains, owner, static_cast<int>(e), t));
       };
-      const int outward = surface.hiddenSide(owner) < 0 ? -1 : 1;
-      int segments = segmentsFor(
-          outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]), at(0.5), outward),
-          options);
+      int segments = segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]),
+                                               at(0.5), surface.outwardSign(owner)),
+                                 options);
       if (segments >= 2) {
         out.edgeRates[e] = segments;
         for (int i = 1; i < segments; ++i) {
@@ -135,8 +133,8 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
         }
         sortByT(points);
       }
-      if (halveOutsideSegments(camera, limit[ends[0]], limit[ends[1]], at, outward, options,
-                               points)) {
+      if (halveOutsideSegments(camera, limit[ends[0]], limit[ends[1]], at,
+                               surface.outwardSign(owner), options, points)) {
         out.edgeRates[e] = std::max(out.edgeRates[e], 2);
       }
     }
@@ -150,9 +148,9 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
     Far::ConstIndexArray verts = base.GetFaceVertices(f);
     for (int v : verts) centroid += limit[v];
     centroid = centroid / static_cast<double>(verts.size());
-    const int outward = surface.hiddenSide(f) < 0 ? -1 : 1;
-    int rate = segmentsFor(
-        outsidePixels(camera, centroid, domains.evaluate(f, domains.center(f)), outward), options);
+    int rate = segmentsFor(outsidePixels(camera, centroid, domains.evaluate(f, domains.center(f)),
+                                         surface.outwardSign(f)),
+                           options);
     for (int e : base.GetFaceEdges(f)) rate = std::max(rate, out.edgeRates[e]);
     if (rate < 2) continue;
     out.interiorRates[f] = rate;

@@ -58,7 +58,7 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
 
   // How far the chord a-b lies outside the surface at its middle, in pixels (0 if inside); the
   // limit normals of an inside-out piece point in.
-  const int outward = domains.surface().hiddenSide(face) < 0 ? -1 : 1;
+  const int outward = domains.surface().outwardSign(face);
   auto sag = [&](int a, int b, FacePoint* middle) {
     const FacePoint& pa = points[a];
     const FacePoint& pb = points[b];

@@ -100,11 +100,11 @@ int loopRate(const FaceDomains& domains, const Camera& camera, int face) {
 constexpr double kBackFacingCos = 1e-3;
 
 size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, FacePiece& piece) {
-  const int hiddenSide = domains.surface().hiddenSide(face);
-  const bool closed = hiddenSide != 0;
+  const bool closed = domains.surface().hiddenSide(face) != 0;
+  const int outward = domains.surface().outwardSign(face);
   auto facing = [&](const Vec3& position, const Vec3& normal) {
-    const double cosine = (closed ? hiddenSide : 1) * contourFunction(camera, position, normal) /
-                          length(camera.viewVector(position));
+    const double cosine =
+        outward * contourFunction(camera, position, normal) / length(camera.viewVector(position));
     return cosine > kBackFacingCos ? 1 : cosine < -kBackFacingCos ? -1 : 0;
   };
   std::vector<int> side(piece.points.size());

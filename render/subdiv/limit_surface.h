@@ -112,6 +112,9 @@ class LimitSurface {
     prepare();
     return hiddenSide_[face];
   }
+  // -1 where the face's limit normal points into its closed piece (an inside-out piece), else 1:
+  // times the normal, the side that is outside the surface.
+  int outwardSign(int face) const { return hiddenSide(face) < 0 ? -1 : 1; }
   // True when the face is evaluated through Far's patch table rather than Bfr.
   bool onFarPatches(int face) const {
     prepare();
