@@ -78,6 +78,20 @@ async function keepPixels(selector, name) {
   }, name);
 }
 
+// Keeps the local WebGL view's current frame under `name`, as keepPixels does for a picture.
+async function keepLocalSnapshot(name) {
+  await page.evaluate(async () => {
+    const img = new Image();
+    img.src = window.limnPage.localSnapshot();
+    await img.decode();
+    img.id = "local-snapshot";
+    img.hidden = true;
+    document.body.append(img);
+  });
+  await keepPixels("#local-snapshot", name);
+  await page.$eval("#local-snapshot", (img) => img.remove());
+}
+
 // The fraction of pixels that differ clearly between two kept pictures of the same size.
 async function differingFraction(a, b) {
   return page.evaluate(([a, b]) => {
@@ -213,19 +227,10 @@ describe("limn's page", () => {
     assert.ok(await page.locator("#gl-canvas").isHidden(), "the local view stays over the picture");
     // The local view and the server's picture of the same camera agree: the page's orbit is
     // the server's.
-    await page.evaluate(async () => {
-      const img = new Image();
-      img.src = window.limnPage.localSnapshot();
-      await img.decode();
-      img.id = "local-snapshot";
-      img.hidden = true;
-      document.body.append(img);
-    });
-    await keepPixels("#local-snapshot", "local");
+    await keepLocalSnapshot("local");
     const disagree = await differingFraction("afterDrag", "local");
     console.log(`local view vs server picture: ${(100 * disagree).toFixed(2)}% of pixels differ`);
     assert.ok(disagree < 0.03, `${(100 * disagree).toFixed(2)}% of the pixels differ`);
-    await page.$eval("#local-snapshot", (img) => img.remove());
     await page.$eval("#gl-canvas", (c) => { c.hidden = true; });
   });
 
@@ -847,16 +852,7 @@ describe("limn's page", () => {
     // The local view draws the same orthographic, zoomed camera as the server.
     await page.waitForFunction(() => window.limnPage.localReady, null, { timeout: 60_000 });
     await keepPixels("#picture", "orthoServer");
-    await page.evaluate(async () => {
-      const img = new Image();
-      img.src = window.limnPage.localSnapshot();
-      await img.decode();
-      img.id = "ortho-snapshot";
-      img.hidden = true;
-      document.body.append(img);
-    });
-    await keepPixels("#ortho-snapshot", "orthoLocal");
-    await page.$eval("#ortho-snapshot", (img) => img.remove());
+    await keepLocalSnapshot("orthoLocal");
     await page.$eval("#gl-canvas", (c) => { c.hidden = true; });
     const disagree = await differingFraction("orthoServer", "orthoLocal");
     console.log(`orthographic local view vs server picture: ${(100 * disagree).toFixed(2)}% differ`);
