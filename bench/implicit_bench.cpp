@@ -1,12 +1,15 @@
 // The polygonisers on the sample scenes of configs/implicit: time, triangles, vertices and
 // geometric error per method and resolution, and the adaptive-vs-finer-grid comparison.
 //
-//   implicit_bench [--resolutions 80,120,360] [--scenes a,b]     the tables
-//   (bench/implicit_results.md) implicit_bench --dump SCENE RESOLUTION FILE                  for
-//   bench/implicit_vs_skimage.py:
-//       samples the field on the marching-cubes grid (all threads; timed), writes it to FILE as
-//       float32 [z][y][x], runs marching cubes on the samples on one thread (best of 5; vertices
-//       by linear interpolation, as scikit-image places them) and prints one JSON line.
+//   implicit_bench [--resolutions 80,120,360] [--scenes a,b]
+//       the tables of bench/implicit_results.md
+//   implicit_bench --dump SCENE RESOLUTION FILE
+//       samples the field on the marching-cubes grid (all threads; timed) and writes it to FILE
+//       as float32 [z][y][x] (bench/implicit_vs_peers.py gives the same file to VTK and
+//       scikit-image); prints one JSON line
+//   implicit_bench --march SCENE RESOLUTION FILE [--threads 1] [--slab 0] [--runs 5]
+//       times marching cubes alone on FILE's samples (vertices by linear interpolation, as VTK
+//       and scikit-image place them), on at most --threads threads; prints one JSON line
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -17,6 +20,7 @@
 
 #include "api/implicit_api.h"
 #include "bench/bench_common.h"
+#include "render/core/parallel.h"
 #include "render/implicit/grid.h"
 #include "render/implicit/polygonize.h"
 
@@ -126,38 +130,63 @@ int tables(const std::vector<std::string>& scenes, const std::vector<int>& resol
 int dump(const std::string& scene, int resolution, const std::string& path) {
   const render::implicit::Field field(sceneField(scene));
   const render::implicit::Grid grid = render::implicit::makeGrid(field.bounds(), resolution);
-  const size_t perLayer = grid.cornersPerLayer();
-  std::vector<float> values(perLayer * (grid.n[2] + 1));
-  auto start = Clock::now();
+  std::vector<float> values(grid.cornersPerLayer() * (grid.n[2] + 1));
+  const auto start = Clock::now();
   render::implicit::sampleLayers(field, grid, 0, grid.n[2], values.data(), {});
   const double sampleMs = msSince(start);
-  double best = 1e300;
-  size_t triangles = 0;
-  for (int run = 0; run < 5; ++run) {
-    render::implicit::RawMesh raw;
-    start = Clock::now();
-    render::implicit::LayerMarcher marcher(grid, raw);
-    for (int k = 0; k < grid.n[2]; ++k) {
-      marcher.march(k, &values[k * perLayer], &values[(k + 1) * perLayer]);
-    }
-    // Vertex positions by linear interpolation, as scikit-image computes them.
-    std::vector<render::Vec3f> positions(raw.vertices.size());
-    for (size_t v = 0; v < raw.vertices.size(); ++v) {
-      const auto& e = raw.vertices[v];
-      const double t = e.fa / (e.fa - e.fb);
-      positions[v] = render::Vec3f(e.a + (e.b - e.a) * t);
-    }
-    best = std::min(best, msSince(start));
-    triangles = raw.indices.size() / 3;
-  }
   std::ofstream out(path, std::ios::binary);
   out.write(reinterpret_cast<const char*>(values.data()),
             static_cast<std::streamsize>(values.size() * sizeof(float)));
   std::printf(
       "{\"scene\":\"%s\",\"resolution\":%d,\"shape\":[%d,%d,%d],\"sampleMs\":%.3f,"
-      "\"mvoxelsPerS\":%.2f,\"mcMs\":%.3f,\"triangles\":%zu}\n",
+      "\"mvoxelsPerS\":%.2f}\n",
       scene.c_str(), resolution, grid.n[2] + 1, grid.n[1] + 1, grid.n[0] + 1, sampleMs,
-      values.size() / (sampleMs * 1e3), best, triangles);
+      values.size() / (sampleMs * 1e3));
+  return 0;
+}
+
+// Marching cubes on samples written by dump: the cells' triangles and the vertices by linear
+// interpolation (as scikit-image and VTK place them), slabs of `slab` layers (0: the whole grid
+// at once), on at most `threads` threads. Only polygonisation is timed, best of `runs`.
+int march(const std::string& scene, int resolution, const std::string& path, unsigned threads,
+          int slab, int runs) {
+  const render::implicit::Field field(sceneField(scene));
+  const render::implicit::Grid grid = render::implicit::makeGrid(field.bounds(), resolution);
+  const size_t perLayer = grid.cornersPerLayer();
+  std::vector<float> values(perLayer * (grid.n[2] + 1));
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(values.data()),
+          static_cast<std::streamsize>(values.size() * sizeof(float)));
+  if (!in) throw std::runtime_error(path + " does not hold this scene's grid");
+  render::parallelThreadLimit() = threads;
+  if (slab <= 0) slab = grid.n[2];
+  double best = 1e300;
+  size_t triangles = 0, vertices = 0;
+  // The output's buffers are kept from run to run (as a VTK filter keeps its output object):
+  // on this machine first touching fresh memory costs about 4 ms per MB, more than the work.
+  render::implicit::RawMesh raw;
+  std::vector<render::Vec3f> positions;
+  for (int run = 0; run < runs; ++run) {
+    raw.vertices.clear();
+    raw.indices.clear();
+    const auto start = Clock::now();
+    render::implicit::SlabMarcher marcher(grid, raw);
+    for (int k0 = 0; k0 < grid.n[2]; k0 += slab) {
+      marcher.march(k0, std::min(grid.n[2], k0 + slab), &values[k0 * perLayer]);
+    }
+    positions.resize(raw.vertices.size());
+    render::parallelFor(raw.vertices.size(), 4096, [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v) {
+        const auto& e = raw.vertices[v];
+        positions[v] = render::Vec3f(e.a + (e.b - e.a) * (e.fa / (e.fa - e.fb)));
+      }
+    });
+    best = std::min(best, msSince(start));
+    triangles = raw.indices.size() / 3;
+    vertices = positions.size();
+  }
+  std::printf("{\"threads\":%u,\"slab\":%d,\"ms\":%.3f,\"triangles\":%zu,\"vertices\":%zu}\n",
+              threads, slab, best, triangles, vertices);
   return 0;
 }
 
@@ -170,6 +199,17 @@ int main(int argc, char** argv) {
     std::string arg = argv[i];
     if (arg == "--dump" && i + 3 < argc)
       return dump(argv[i + 1], std::stoi(argv[i + 2]), argv[i + 3]);
+    if (arg == "--march" && i + 3 < argc) {
+      unsigned threads = 1;
+      int slab = 0, runs = 5;
+      for (int o = i + 4; o + 1 < argc; o += 2) {
+        const std::string option = argv[o];
+        if (option == "--threads") threads = static_cast<unsigned>(std::stoi(argv[o + 1]));
+        if (option == "--slab") slab = std::stoi(argv[o + 1]);
+        if (option == "--runs") runs = std::stoi(argv[o + 1]);
+      }
+      return march(argv[i + 1], std::stoi(argv[i + 2]), argv[i + 3], threads, slab, runs);
+    }
     if (arg == "--scenes" && i + 1 < argc) scenes = bench::splitList(argv[++i]);
     if (arg == "--resolutions" && i + 1 < argc) {
       resolutions.clear();

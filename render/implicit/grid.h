@@ -52,21 +52,48 @@ inline int cubeConfiguration(const float v[8]) {
   return configuration;
 }
 
-// Marching cubes layer by layer: cells of layer k lie between corner layers k and k + 1. Edge
-// vertices are shared through per-edge index arrays of the two corner layers, so each vertex is
-// made once, by the first cell that needs it.
-class LayerMarcher {
+// Marching cubes over slabs of consecutive layers, edge by edge and in parallel. A row of
+// corners (fixed j, k) owns the grid edges that start at its corners: its x edges, its y edges
+// (to row j + 1) and its z edges (to layer k + 1). Each slab is marched in passes over its rows,
+// every pass on all threads (parallelFor) and with no locks:
+//   1. classify: each row's corners as inside bits (value > 0), 64 to a word;
+//   2. count, from the bits alone: the crossed edges each row owns and the triangles of the row
+//      of cells above it; cells whose eight corners agree are skipped a word at a time, so only
+//      the rows' trimmed runs of surface cells cost anything;
+//   3. prefix sums of the counts (serial: one number per row);
+//   4. write each row's vertices and triangles at their offsets. A vertex's index is its row's
+//      offset plus its rank among the row's crossed edges of its axis (a popcount), so a cell
+//      finds the vertices of its twelve edges without an index array or a hash map.
+// Every crossed edge gets exactly one vertex. Vertices are numbered layer by layer (a layer's x
+// and y edges row by row, then its z edges row by row), triangles in cell order (k, j, i), so
+// the mesh is the same whatever the number of threads, with the triangles the case table draws.
+class SlabMarcher {
  public:
-  LayerMarcher(const Grid& grid, RawMesh& out);
-  void march(int k, const float* bottom, const float* top);
-  size_t cellsWithSurface() const { return cellsWithSurface_; }
+  SlabMarcher(const Grid& grid, RawMesh& out);
+  // The cells of layers k0..k1 - 1, from F - iso at corner layers k0..k1 (`values`, x fastest).
+  // Slabs must come in order, each starting at the layer where the previous one ended.
+  void march(int k0, int k1, const float* values);
 
  private:
+  struct Slab;
+  struct CellRow;
+  class EdgeRanks;
+  void classify(const Slab& slab);
+  void count(const Slab& slab);
+  void assignOffsets(const Slab& slab);
+  void write(const Slab& slab);
+  void writeVertices(const Slab& slab, size_t r, bool withZ);
+  void writeTriangles(size_t r, EdgeRanks& ranks);
+  CellRow cellRow(size_t r, bool withNeighbours) const;
+
   const Grid& grid_;
   RawMesh& out_;
-  std::vector<uint32_t> xBottom_, xTop_, yBottom_, yTop_, z_;
-  std::vector<uint8_t> columns_;
-  size_t cellsWithSurface_ = 0;
+  int words_;                       // bit words per row of corners, one of them zero padding
+  std::vector<uint64_t> bits_;      // the slab's rows of inside bits
+  std::vector<uint32_t> xyVertex_;  // per row: its x and y edges' count, then first vertex
+  std::vector<uint32_t> zVertex_;   // per row: its z edges' count, then first vertex
+  std::vector<uint32_t> triangle_;  // per row: its row of cells' triangles, then first triangle
+  uint32_t layerVertex_ = 0;        // the first vertex of the next slab's first layer
 };
 
 // The vertices moved from their linear interpolation onto the surface (regula falsi on the

@@ -1,15 +1,17 @@
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "render/core/parallel.h"
 #include "render/implicit/cube_table.h"
 #include "render/implicit/grid.h"
 
 namespace limn::render::implicit {
-
-namespace {
-constexpr uint32_t kNone = UINT32_MAX;
-}
 
 Grid makeGrid(const Bounds& domain, int resolution) {
   const Vec3 size = domain.hi - domain.lo;
@@ -44,75 +46,329 @@ void sampleLayers(const Field& field, const Grid& grid, int k0, int k1, float* o
   cancel.check();
 }
 
-LayerMarcher::LayerMarcher(const Grid& grid, RawMesh& out) : grid_(grid), out_(out) {
-  const size_t nx = grid.n[0], ny = grid.n[1];
-  xBottom_.assign(nx * (ny + 1), kNone);
-  xTop_ = xBottom_;
-  yBottom_.assign((nx + 1) * ny, kNone);
-  yTop_ = yBottom_;
-  z_.assign((nx + 1) * (ny + 1), kNone);
+namespace {
+
+// Bit i of a row's word w is corner i = 64 w + i; the last word of every row is zero padding,
+// so reading word w + 1 is always allowed for a real word w.
+
+// The inside bits (value > 0) of `count` <= 64 consecutive corners. NaN and exactly 0 are
+// outside, as cubeConfiguration has them.
+uint64_t insideBits(const float* values, int count) {
+  uint64_t bits = 0;
+  int b = 0;
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps();
+  for (; b + 4 <= count; b += 4) {
+    const __m128 inside = _mm_cmpgt_ps(_mm_loadu_ps(values + b), zero);
+    bits |= static_cast<uint64_t>(_mm_movemask_ps(inside)) << b;
+  }
+#endif
+  for (; b < count; ++b) bits |= static_cast<uint64_t>(values[b] > 0.0f) << b;
+  return bits;
 }
 
-void LayerMarcher::march(int k, const float* bottom, const float* top) {
-  const int nx = grid_.n[0], ny = grid_.n[1];
-  const size_t stride = nx + 1;
-  const CubeTable& table = CubeTable::instance();
-  const auto& edges = cubeEdges();
-  std::fill(z_.begin(), z_.end(), kNone);
-  // Per column of corners (x = i) of a row of cells: the inside bits of its four corners at the
-  // places they take in a cube's configuration (bits 0, 2, 4, 6: y0z0, y1z0, y0z1, y1z1), so a
-  // cell's configuration is column[i] | column[i + 1] << 1, and empty cells cost two loads.
-  columns_.resize(stride);
-  for (int j = 0; j < ny; ++j) {
-    const float* b0 = bottom + j * stride;
-    const float* b1 = b0 + stride;
-    const float* t0 = top + j * stride;
-    const float* t1 = t0 + stride;
-    for (size_t i = 0; i < stride; ++i) {
-      columns_[i] = static_cast<uint8_t>((b0[i] > 0.0f) | (b1[i] > 0.0f) << 2 |
-                                         (t0[i] > 0.0f) << 4 | (t1[i] > 0.0f) << 6);
+// The bits of corners i + 1 at places i.
+inline uint64_t nextCorners(const uint64_t* row, int w) {
+  return (row[w] >> 1) | (row[w + 1] << 63);
+}
+
+// Corners i and i + 1 as bits 0 and 1.
+inline int cornerPair(const uint64_t* row, int i) {
+  const int w = i >> 6, b = i & 63;
+  return static_cast<int>(((row[w] >> b) | ((row[w + 1] << 1) << (63 - b))) & 3);
+}
+
+// Set bits of a word: the popcnt instruction where the build targets it, else the same in a
+// dozen inline operations (a library call per word costs more than the rest of the loop).
+inline uint32_t bitCount(uint64_t x) {
+#if defined(__POPCNT__)
+  return static_cast<uint32_t>(__builtin_popcountll(x));
+#else
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<uint32_t>((x * 0x0101010101010101ull) >> 56);
+#endif
+}
+
+inline uint64_t bitsBelow(int b) { return (uint64_t{1} << b) - 1; }
+
+template <typename Visit>  // Visit: void(int i) for each set bit i, in increasing order
+void forEachBit(uint64_t word, int w, const Visit& visit) {
+  while (word) {
+    visit(64 * w + __builtin_ctzll(word));
+    word &= word - 1;
+  }
+}
+
+// The marching-cubes table flattened for the inner loop, with each cube edge's place among the
+// eight edge masks of a row of cells (CellRow) and its x offset from the cell's corner 0.
+struct CaseTable {
+  uint16_t begin[257];
+  std::vector<uint8_t> edges;
+  uint8_t mask[12], dx[12];
+
+  static const CaseTable& instance() {
+    static const CaseTable table;
+    return table;
+  }
+
+ private:
+  CaseTable() {
+    const CubeTable& cubes = CubeTable::instance();
+    for (int c = 0; c < 256; ++c) {
+      begin[c] = static_cast<uint16_t>(edges.size());
+      edges.insert(edges.end(), cubes.triangles(c).begin(), cubes.triangles(c).end());
     }
-    for (int i = 0; i < nx; ++i) {
-      const int configuration = columns_[i] | columns_[i + 1] << 1;
-      if (configuration == 0 || configuration == 255) continue;
-      ++cellsWithSurface_;
-      const size_t c00 = j * stride + i;
-      const float v[8] = {
-          bottom[c00], bottom[c00 + 1], bottom[c00 + stride], bottom[c00 + stride + 1],
-          top[c00],    top[c00 + 1],    top[c00 + stride],    top[c00 + stride + 1]};
-      const std::vector<uint8_t>& triangles = table.triangles(configuration);
-      for (uint8_t e : triangles) {
-        // The slot of edge e of cell (i, j) among the two layers' edge arrays.
-        uint32_t* slot;
-        const CubeEdge& edge = edges[e];
-        const int ca = edge.a;
-        const int di = ca & 1, dj = (ca >> 1) & 1, dk = (ca >> 2) & 1;
-        switch (edge.axis) {
-          case 0:
-            slot = &(dk ? xTop_ : xBottom_)[(j + dj) * static_cast<size_t>(nx) + i];
-            break;
-          case 1:
-            slot = &(dk ? yTop_ : yBottom_)[(j)*stride + i + di];
-            break;
-          default:
-            slot = &z_[(j + dj) * stride + i + di];
-            break;
-        }
-        if (*slot == kNone) {
-          const int cb = edge.b;
-          *slot = out_.addVertex(
-              grid_.corner(i + di, j + dj, k + dk),
-              grid_.corner(i + (cb & 1), j + ((cb >> 1) & 1), k + ((cb >> 2) & 1)), v[ca], v[cb]);
-        }
-        out_.indices.push_back(*slot);
-      }
+    begin[256] = static_cast<uint16_t>(edges.size());
+    for (int e = 0; e < 12; ++e) {
+      const CubeEdge& edge = cubeEdges()[e];
+      const int dy = (edge.a >> 1) & 1, dz = (edge.a >> 2) & 1;
+      const int masks[3] = {dy + 2 * dz, 4 + dz, 6 + dy};  // x of a..d, y of a, c, z of a, b
+      mask[e] = static_cast<uint8_t>(masks[edge.axis]);
+      dx[e] = static_cast<uint8_t>(edge.a & 1);
     }
   }
-  // The top layer's x and y edges are the next layer's bottom ones.
-  std::swap(xBottom_, xTop_);
-  std::swap(yBottom_, yTop_);
-  std::fill(xTop_.begin(), xTop_.end(), kNone);
-  std::fill(yTop_.begin(), yTop_.end(), kNone);
+};
+
+}  // namespace
+
+// The four rows of corners around a row of cells: a (j, k), b (j + 1, k), c (j, k + 1),
+// d (j + 1, k + 1), i.e. a cube's corners 0-1, 2-3, 4-5, 6-7.
+struct SlabMarcher::CellRow {
+  const uint64_t *a, *b, *c, *d;
+  int realWords;
+  uint64_t lastCells;  // the cells of the last real word (cells i < n0)
+
+  uint64_t cellMask(int w) const { return w + 1 == realWords ? lastCells : ~uint64_t{0}; }
+  uint64_t xEdges(const uint64_t* row, int w) const {
+    return (row[w] ^ nextCorners(row, w)) & cellMask(w);
+  }
+  uint64_t mixedColumns(int w) const { return (a[w] ^ b[w]) | (a[w] ^ c[w]) | (a[w] ^ d[w]); }
+  // The cells whose eight corners do not all agree.
+  uint64_t surfaceCells(int w) const {
+    const uint64_t mixed = mixedColumns(w), mixedNext = (mixed >> 1) | (mixedColumns(w + 1) << 63);
+    return (mixed | mixedNext | (a[w] ^ nextCorners(a, w))) & cellMask(w);
+  }
+  int configuration(int i) const {
+    return cornerPair(a, i) | cornerPair(b, i) << 2 | cornerPair(c, i) << 4 | cornerPair(d, i) << 6;
+  }
+};
+
+// The crossed edges around a row of cells as eight masks (x edges of rows a, b, c, d; y edges
+// of a and c; z edges of a and b), each with its first vertex and per-word ranks, so that the
+// vertex of a crossed edge is one popcount away.
+class SlabMarcher::EdgeRanks {
+ public:
+  explicit EdgeRanks(int realWords)
+      : words_(realWords), masks_(8 * realWords), ranks_(8 * realWords) {}
+
+  template <typename Word>  // Word: uint64_t(int w)
+  void set(int m, uint32_t first, const Word& word) {
+    uint32_t rank = first;
+    for (int w = 0; w < words_; ++w) {
+      masks_[m * words_ + w] = word(w);
+      ranks_[m * words_ + w] = rank;
+      rank += bitCount(masks_[m * words_ + w]);
+    }
+    end_[m] = rank;
+  }
+  uint32_t end(int m) const { return end_[m]; }
+  uint32_t vertex(int m, int i) const {
+    const int at = m * words_ + (i >> 6);
+    return ranks_[at] + bitCount(masks_[at] & bitsBelow(i & 63));
+  }
+
+ private:
+  int words_;
+  std::vector<uint64_t> masks_;
+  std::vector<uint32_t> ranks_;
+  uint32_t end_[8] = {};
+};
+
+struct SlabMarcher::Slab {
+  int k0, k1;
+  const float* values;
+  int layers;   // corner layers, k1 - k0 + 1
+  size_t rows;  // rows of corners
+  bool last;    // k1 is the grid's last layer: its x and y edges are this slab's to write
+};
+
+SlabMarcher::SlabMarcher(const Grid& grid, RawMesh& out)
+    : grid_(grid), out_(out), words_((grid.n[0] + 1 + 63) / 64 + 1) {}
+
+void SlabMarcher::march(int k0, int k1, const float* values) {
+  const int layers = k1 - k0 + 1;
+  const Slab slab{
+      k0, k1, values, layers, static_cast<size_t>(layers) * (grid_.n[1] + 1), k1 == grid_.n[2]};
+  bits_.resize(slab.rows * words_);
+  xyVertex_.resize(slab.rows);
+  zVertex_.resize(slab.rows);
+  triangle_.resize(slab.rows);
+  auto t0 = std::chrono::steady_clock::now();
+  auto lap = [&](const char* what) {
+    auto t = std::chrono::steady_clock::now();
+    if (getenv("MC_TIMES"))
+      fprintf(stderr, "%s %.2f  ", what, std::chrono::duration<double, std::milli>(t - t0).count());
+    t0 = t;
+  };
+  classify(slab);
+  lap("classify");
+  count(slab);
+  lap("count");
+  assignOffsets(slab);
+  lap("offsets");
+  write(slab);
+  lap("write");
+}
+
+void SlabMarcher::classify(const Slab& slab) {
+  const int nx = grid_.n[0] + 1;
+  parallelFor(slab.rows, 64, [&](size_t begin, size_t end) {
+    for (size_t r = begin; r < end; ++r) {
+      const float* values = slab.values + r * nx;
+      uint64_t* row = &bits_[r * words_];
+      for (int w = 0; w < words_; ++w)
+        row[w] = insideBits(values + 64 * w, std::clamp(nx - 64 * w, 0, 64));
+    }
+  });
+}
+
+SlabMarcher::CellRow SlabMarcher::cellRow(size_t r, bool withNeighbours) const {
+  const size_t layerWords = static_cast<size_t>(grid_.n[1] + 1) * words_;
+  const uint64_t* a = &bits_[r * words_];
+  const int realWords = words_ - 1;
+  const uint64_t lastCells = bitsBelow(grid_.n[0] - 64 * (realWords - 1));
+  if (!withNeighbours) return {a, nullptr, nullptr, nullptr, realWords, lastCells};
+  return {a, a + words_, a + layerWords, a + layerWords + words_, realWords, lastCells};
+}
+
+void SlabMarcher::count(const Slab& slab) {
+  const int ny = grid_.n[1] + 1;
+  const CaseTable& table = CaseTable::instance();
+  parallelFor(slab.rows, 32, [&](size_t begin, size_t end) {
+    for (size_t r = begin; r < end; ++r) {
+      const bool nextRow = static_cast<int>(r % ny) + 1 < ny;
+      const bool nextLayer = static_cast<int>(r / ny) + 1 < slab.layers;
+      const uint64_t* a = &bits_[r * words_];
+      const CellRow row = cellRow(r, nextRow && nextLayer);
+      uint32_t xy = 0, z = 0, triangles = 0;
+      for (int w = 0; w < row.realWords; ++w) {
+        xy += bitCount(row.xEdges(a, w));
+        if (nextRow) xy += bitCount(a[w] ^ a[w + words_]);
+        if (nextLayer) z += bitCount(a[w] ^ a[w + (ny * words_)]);
+        if (!(nextRow && nextLayer)) continue;
+        forEachBit(row.surfaceCells(w), w, [&](int i) {
+          const int c = row.configuration(i);
+          triangles += (table.begin[c + 1] - table.begin[c]) / 3;
+        });
+      }
+      xyVertex_[r] = xy;
+      zVertex_[r] = z;
+      triangle_[r] = triangles;
+    }
+  });
+}
+
+// Layer by layer: its rows' x and y vertices, then its rows' z vertices. The slab's last layer
+// gets its x and y offsets (its cells' triangles use them) but is numbered again, identically,
+// as the next slab's first layer, which writes its vertices.
+void SlabMarcher::assignOffsets(const Slab& slab) {
+  const size_t ny = grid_.n[1] + 1;
+  uint32_t vertex = layerVertex_;
+  auto number = [&](std::vector<uint32_t>& counts, size_t layer) {
+    for (size_t r = layer * ny; r < (layer + 1) * ny; ++r) {
+      const uint32_t n = counts[r];
+      counts[r] = vertex;
+      vertex += n;
+    }
+  };
+  for (int layer = 0; layer + 1 < slab.layers; ++layer) {
+    number(xyVertex_, layer);
+    number(zVertex_, layer);
+  }
+  layerVertex_ = vertex;
+  number(xyVertex_, slab.layers - 1);
+  out_.vertices.resize(slab.last ? vertex : layerVertex_);
+
+  uint32_t triangle = static_cast<uint32_t>(out_.indices.size() / 3);
+  for (size_t r = 0; r < slab.rows; ++r) {
+    const uint32_t n = triangle_[r];
+    triangle_[r] = triangle;
+    triangle += n;
+  }
+  out_.indices.resize(static_cast<size_t>(triangle) * 3);
+}
+
+void SlabMarcher::write(const Slab& slab) {
+  const int ny = grid_.n[1] + 1;
+  parallelFor(slab.rows, 32, [&](size_t begin, size_t end) {
+    EdgeRanks ranks(words_ - 1);
+    for (size_t r = begin; r < end; ++r) {
+      const bool nextLayer = static_cast<int>(r / ny) + 1 < slab.layers;
+      if (nextLayer || slab.last) writeVertices(slab, r, nextLayer);
+      if (nextLayer && static_cast<int>(r % ny) + 1 < ny) writeTriangles(r, ranks);
+    }
+  });
+}
+
+// Row r's x and y vertices, and its z vertices when the slab holds the next layer.
+void SlabMarcher::writeVertices(const Slab& slab, size_t r, bool withZ) {
+  const int nx = grid_.n[0] + 1, ny = grid_.n[1] + 1;
+  const int j = static_cast<int>(r % ny), k = slab.k0 + static_cast<int>(r / ny);
+  const float* f = slab.values + r * nx;
+  const uint64_t* a = &bits_[r * words_];
+  const CellRow row = cellRow(r, false);
+  const size_t layer = static_cast<size_t>(ny) * nx;
+  EdgeVertex* out = &out_.vertices[xyVertex_[r]];
+  for (int w = 0; w < row.realWords; ++w) {
+    forEachBit(row.xEdges(a, w), w, [&](int i) {
+      *out++ = {grid_.corner(i, j, k), grid_.corner(i + 1, j, k), f[i], f[i + 1]};
+    });
+  }
+  if (j + 1 < ny) {
+    for (int w = 0; w < row.realWords; ++w) {
+      forEachBit(a[w] ^ a[w + words_], w, [&](int i) {
+        *out++ = {grid_.corner(i, j, k), grid_.corner(i, j + 1, k), f[i], f[i + nx]};
+      });
+    }
+  }
+  if (!withZ) return;
+  out = &out_.vertices[zVertex_[r]];
+  const size_t nextLayer = static_cast<size_t>(ny) * words_;
+  for (int w = 0; w < row.realWords; ++w) {
+    forEachBit(a[w] ^ a[w + nextLayer], w, [&](int i) {
+      *out++ = {grid_.corner(i, j, k), grid_.corner(i, j, k + 1), f[i], f[i + layer]};
+    });
+  }
+}
+
+// The triangles of the row of cells above row r (between rows j, j + 1 and layers k, k + 1).
+void SlabMarcher::writeTriangles(size_t r, EdgeRanks& ranks) {
+  const CellRow row = cellRow(r, true);
+  bool any = false;
+  for (int w = 0; w < row.realWords && !any; ++w) any = row.surfaceCells(w) != 0;
+  if (!any) return;
+  const size_t ny = grid_.n[1] + 1, b = r + 1, c = r + ny, d = c + 1;
+  ranks.set(0, xyVertex_[r], [&](int w) { return row.xEdges(row.a, w); });
+  ranks.set(1, xyVertex_[b], [&](int w) { return row.xEdges(row.b, w); });
+  ranks.set(2, xyVertex_[c], [&](int w) { return row.xEdges(row.c, w); });
+  ranks.set(3, xyVertex_[d], [&](int w) { return row.xEdges(row.d, w); });
+  ranks.set(4, ranks.end(0), [&](int w) { return row.a[w] ^ row.b[w]; });
+  ranks.set(5, ranks.end(2), [&](int w) { return row.c[w] ^ row.d[w]; });
+  ranks.set(6, zVertex_[r], [&](int w) { return row.a[w] ^ row.c[w]; });
+  ranks.set(7, zVertex_[b], [&](int w) { return row.b[w] ^ row.d[w]; });
+  const CaseTable& table = CaseTable::instance();
+  uint32_t* out = &out_.indices[3 * static_cast<size_t>(triangle_[r])];
+  for (int w = 0; w < row.realWords; ++w) {
+    forEachBit(row.surfaceCells(w), w, [&](int i) {
+      const int configuration = row.configuration(i);
+      for (int e = table.begin[configuration]; e < table.begin[configuration + 1]; ++e) {
+        const uint8_t edge = table.edges[e];
+        *out++ = ranks.vertex(table.mask[edge], i + table.dx[edge]);
+      }
+    });
+  }
 }
 
 }  // namespace limn::render::implicit

@@ -29,13 +29,13 @@ void checkTriangles(size_t triangles, size_t limit) {
 }
 
 // Every cell of the grid, slab by slab: a slab's layers are sampled on all threads, then marched
-// in order (the marcher keeps the previous layer's edge vertices).
+// on all threads (slabs in order: a slab's first layer is the previous one's last).
 void marchGrid(const Field& field, const Grid& grid, size_t maxTriangles, RawMesh& raw,
                PolygonizerStats& stats, const CancelToken& cancel) {
   constexpr int kSlab = 16;
   const size_t perLayer = grid.cornersPerLayer();
   std::vector<float> values((kSlab + 1) * perLayer);
-  LayerMarcher marcher(grid, raw);
+  SlabMarcher marcher(grid, raw);
   for (int k0 = 0; k0 < grid.n[2]; k0 += kSlab) {
     const int k1 = std::min(grid.n[2], k0 + kSlab);
     auto start = Clock::now();
@@ -47,9 +47,7 @@ void marchGrid(const Field& field, const Grid& grid, size_t maxTriangles, RawMes
     }
     stats.sampleMs += msSince(start);
     start = Clock::now();
-    for (int k = k0; k < k1; ++k) {
-      marcher.march(k, &values[(k - k0) * perLayer], &values[(k - k0 + 1) * perLayer]);
-    }
+    marcher.march(k0, k1, values.data());
     stats.polygonizeMs += msSince(start);
     checkTriangles(raw.indices.size() / 3, maxTriangles);
     cancel.check();
