@@ -2,6 +2,8 @@
 
 #include <opensubdiv/bfr/tessellation.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "render/core/error.h"
@@ -25,7 +27,8 @@ struct FacePiece {
   size_t coarseTriangles = 0, curveSamples = 0, unresolved = 0;
   int splits = 0;
   bool odd = false;
-  size_t culled = 0;  // triangles left out as hidden (cullHidden)
+  size_t culled = 0;      // triangles left out as hidden (cullHidden)
+  bool thinFold = false;  // two of its contour curves pass within kFoldSliverPx in the image
 };
 
 // A ring face refined by refineConcaveChords: Bfr's tessellation with the face's edge rates
@@ -97,7 +100,60 @@ int loopRate(const FaceDomains& domains, const Camera& camera, int face) {
 // whose centre faces away: it belongs to the back sheet of a fold, which the front sheet
 // covers where the outline is convex; where the outline is concave (a spike's flanks, a
 // curved strip seen edge-on) its chord spans the concavity and stands pixels past the outline.
+// On a closed piece, a face where two contour curves pass within kFoldSliverPx of each other in
+// the image holds a fold thinner than their chords' error: the chords can cross and open a gap
+// between the front sheets that only the fold's own back-facing triangles cover (a dotted line
+// of missing pixels tens of pixels long on a ribbed cactus seen along a rib). There, hidden
+// triangles on the contour that are thinner than kFoldSliverPx are kept: they can neither darken
+// nor move the outline by more than their width.
 constexpr double kBackFacingCos = 1e-3;
+constexpr double kFoldSliverPx = 1.0;
+
+double imageDistancePx(const Camera& camera, const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 pp = camera.project(p), pa = camera.project(a), pb = camera.project(b);
+  const double dx = pb.x - pa.x, dy = pb.y - pa.y, len2 = dx * dx + dy * dy;
+  const double t =
+      len2 > 0 ? std::clamp(((pp.x - pa.x) * dx + (pp.y - pa.y) * dy) / len2, 0.0, 1.0) : 0.0;
+  return std::hypot(pa.x + t * dx - pp.x, pa.y + t * dy - pp.y);
+}
+
+// Whether a point of curve `a` lies within kFoldSliverPx of a segment of curve `b` that does not
+// end at that point (`a` and `b` may be one curve: a hairpin whose legs nearly meet).
+bool curvesCloseInImage(const Camera& camera, const ContourCurve& a, const ContourCurve& b) {
+  const bool same = &a == &b;
+  for (size_t i = 0; i < a.points.size(); ++i) {
+    for (size_t k = 0; k + 1 < b.points.size(); ++k) {
+      if (same && (k + 1 >= i && k <= i)) continue;  // segments through point i
+      if (imageDistancePx(camera, a.points[i].position, b.points[k].position,
+                          b.points[k + 1].position) < kFoldSliverPx) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+bool hasThinFold(const Camera& camera, const std::vector<ContourCurve>& curves) {
+  for (size_t i = 0; i < curves.size(); ++i) {
+    for (size_t j = i; j < curves.size(); ++j) {
+      if (curvesCloseInImage(camera, curves[i], curves[j]) ||
+          (i != j && curvesCloseInImage(camera, curves[j], curves[i]))) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+// The triangle's width in the image: twice its projected area over its longest projected edge.
+double imageWidthPx(const Camera& camera, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 pa = camera.project(a), pb = camera.project(b), pc = camera.project(c);
+  const double area2 = std::abs((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x));
+  const double longest =
+      std::max({std::hypot(pb.x - pa.x, pb.y - pa.y), std::hypot(pc.x - pb.x, pc.y - pb.y),
+                std::hypot(pa.x - pc.x, pa.y - pc.y)});
+  return longest > 0 ? area2 / longest : 0;
+}
 
 size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, FacePiece& piece) {
   const bool closed = domains.surface().hiddenSide(face) != 0;
@@ -115,6 +171,11 @@ size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, Fa
   std::erase_if(piece.triangles, [&](const std::array<int, 3>& t) {
     const int a = side[t[0]], b = side[t[1]], c = side[t[2]];
     if (a < 0 || b < 0 || c < 0) return false;
+    if (closed && piece.thinFold && (a == 0 || b == 0 || c == 0) &&
+        imageWidthPx(camera, piece.points[t[0]].position, piece.points[t[1]].position,
+                     piece.points[t[2]].position) < kFoldSliverPx) {
+      return false;
+    }
     if (a > 0 && b > 0 && c > 0) return closed;
     if (!closed && (a != 0 || b != 0 || c != 0)) return false;
     const Vec2& ua = piece.points[t[0]].uv;
@@ -167,6 +228,7 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
     paths.push_back(std::move(path));
     piece.curves.push_back(std::move(contour));
   }
+  piece.thinFold = hasThinFold(camera, piece.curves);
   std::vector<Vec2> uv;
   uv.reserve(piece.points.size());
   for (const FacePoint& p : piece.points) uv.push_back(p.uv);

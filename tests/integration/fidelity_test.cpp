@@ -116,6 +116,20 @@ TEST(AdaptiveOutline, EdgesSeenEndOnAtASilhouetteAreDicedAsIfFaceOn) {
   EXPECT_LE(m.outlinePx, 0.5) << m.warnings;
 }
 
+// A fold thinner than its contours' chord error: the ribbed cactus seen nearly along a rib. A
+// hairpin of contour inside one face bounds a back-facing fold a fraction of a pixel wide; its
+// sampled legs crossed in the image, and with the fold's hidden triangles culled a dotted line
+// of pixels inside the body went uncovered: 22 px at 512^2 (44 px at 1024^2).
+TEST(ThinFold, AHairpinContourInsideTheOutlineLeavesNoHoles) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  Measured m =
+      render(server, meshJson(corpusDir() / "cactus.obj"), R"("method": "silhouette")",
+             R"({"eye": [-0.5395722, 1.3172251, 2.6654705], "target": [0, 0.6, 0], "up": [0, 1, 0],
+          "fovYDeg": 20.5226957, "width": 512, "height": 512})");
+  ASSERT_EQ(m.status, 200) << m.body;
+  EXPECT_LE(m.outlinePx, 1.0) << m.warnings;
+}
+
 // Pieces wound inside-out (every face clockwise seen from outside: their limit normals point
 // in), common in production models. The methods cull the side of a closed piece that faces away
 // from the eye, and the silhouette method's concave correction asks which side of the surface
