@@ -11,6 +11,9 @@
 // reference cache (the same request again).
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -37,20 +40,59 @@ struct Config {
   int supersample = 4;
   int repeat = 3;
   bool crossCheck = false;
+  bool values = false;
   std::string corpus = LIMN_SOURCE_DIR "/../shared/corpus/osd-shapes";
   std::vector<std::string> shapes;
+  std::string modelDir;
+  std::vector<std::string> models, only;
 };
 
-std::vector<NamedMesh> loadMeshes(const Config& config) {
-  std::vector<NamedMesh> meshes = {
-      {"pawn (own, 560 faces)", testing::pawn()},
-      {"torus 40x25 (own, 1000 faces)", testing::torus(40, 25, false)},
-      {"bumpy ball (own, 1536 faces)", testing::bumpyBall(16)},
+// A make_models.py model: `dir`/`name`.obj, its scheme named on a "# scheme" line.
+std::optional<render::mesh::ControlMesh> readModel(const std::string& dir,
+                                                   const std::string& name) {
+  std::ifstream file(dir + "/" + name + ".obj");
+  if (!file) return std::nullopt;
+  std::stringstream text;
+  text << file.rdbuf();
+  const std::string obj = text.str();
+  render::mesh::Scheme scheme = render::mesh::Scheme::CatmullClark;
+  if (obj.find("# scheme loop") != std::string::npos) scheme = render::mesh::Scheme::Loop;
+  return formats::readObj(obj, scheme, {}).mesh;
+}
+
+std::vector<NamedMesh> ownMeshes() {
+  return {
+      {"pawn (own)", testing::pawn()},
+      {"torus 40x25 (own)", testing::torus(40, 25, false)},
+      {"bumpy ball (own)", testing::bumpyBall(16)},
+      {"Loop creature(11) (own)", testing::loopCreature(11)},
+      {"creature(29) (own)", testing::creature(29)},
+      {"torus 400x200 (own)", testing::torus(400, 200, false)},
   };
+}
+
+// --only picks rows by name prefix; --models adds make_models.py's OBJ files (scheme from the
+// file's "# scheme" line).
+std::vector<NamedMesh> loadMeshes(const Config& config) {
+  std::vector<NamedMesh> meshes;
+  for (NamedMesh& m : ownMeshes()) meshes.push_back(std::move(m));
   for (const std::string& shape : config.shapes) {
     if (auto mesh = bench::readShape(config.corpus, shape)) meshes.push_back({shape, *mesh});
   }
-  return meshes;
+  for (const std::string& model : config.models) {
+    if (auto mesh = readModel(config.modelDir, model)) meshes.push_back({model, *mesh});
+  }
+  if (config.only.empty()) return meshes;
+  std::vector<NamedMesh> picked;
+  for (NamedMesh& m : meshes) {
+    for (const std::string& prefix : config.only) {
+      if (m.name.rfind(prefix, 0) == 0) {
+        picked.push_back(std::move(m));
+        break;
+      }
+    }
+  }
+  return picked;
 }
 
 RenderJob adaptiveJob(const NamedMesh& m, const Config& config) {
@@ -64,6 +106,48 @@ RenderJob adaptiveJob(const NamedMesh& m, const Config& config) {
   return job;
 }
 
+// Every metric of one comparison, printed exactly (%.17g), so that two builds' outputs can be
+// compared with diff: `--values` checks that a change to the metrics' speed left them unchanged.
+void printValues(const std::string& label, const render::metrics::Metrics& m) {
+  const auto& s = *m.silhouette;
+  std::printf("%s sil %.17g %.17g %.17g %ld outline %.17g %.17g\n", label.c_str(), s.hausdorffPx,
+              s.meanPx, s.iou, s.mismatchPx, s.outlineHausdorffPx.value_or(-1),
+              s.outlineMeanPx.value_or(-1));
+  std::printf("%s image %.17g %.17g depth %.17g %.17g normal %.17g %.17g\n", label.c_str(),
+              m.image->rmse, m.image->psnr, m.depth->maxRel, m.depth->meanRel, m.normal->meanDeg,
+              m.normal->maxDeg);
+  std::printf("%s geometry %.17g %.17g %.17g %.17g\n", label.c_str(), m.geometry->maxDist,
+              m.geometry->meanDist, m.geometry->relMaxDist, m.geometry->relMeanDist);
+}
+
+// Each mesh from three views with three methods at the bench's size, every metric printed.
+void printAllValues(const Config& config, render::pipeline::RenderContext& context) {
+  const std::pair<Method, double> methods[] = {
+      {Method::Adaptive, 1.0}, {Method::Adaptive, 8.0}, {Method::Coarse, 1.0}};
+  const render::Orbit views[] = {{0, 0, {}}, {37, 24, {}}, {-120, -35, 1.6}};
+  render::pipeline::JobLimits limits;
+  for (const NamedMesh& m : loadMeshes(config)) {
+    for (const render::Orbit& view : views) {
+      for (auto [method, rate] : methods) {
+        RenderJob job = adaptiveJob(m, config);
+        job.method = method;
+        job.params.dicingRate = rate;
+        job.camera.orbit = view;
+        job.reference = true;
+        char label[256];
+        std::snprintf(label, sizeof label, "%s az%g el%g m%d r%g |", m.name.c_str(),
+                      view.azimuthDeg, view.elevationDeg, static_cast<int>(method), rate);
+        try {
+          printValues(label, render::pipeline::run(job, limits, context, {}).metrics);
+        } catch (const std::exception& e) {
+          std::printf("%s failed: %s\n", label, e.what());
+        }
+        std::fflush(stdout);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -72,6 +156,10 @@ int main(int argc, char** argv) {
     std::string flag = argv[i];
     if (flag == "--cross-check") {
       config.crossCheck = true;
+      continue;
+    }
+    if (flag == "--values") {
+      config.values = true;
       continue;
     }
     if (i + 1 >= argc) {
@@ -89,6 +177,12 @@ int main(int argc, char** argv) {
       config.corpus = value;
     else if (flag == "--shapes")
       config.shapes = bench::splitList(value);
+    else if (flag == "--model-dir")
+      config.modelDir = value;
+    else if (flag == "--models")
+      config.models = bench::splitList(value);
+    else if (flag == "--only")
+      config.only = bench::splitList(value);
     else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;
@@ -96,34 +190,38 @@ int main(int argc, char** argv) {
   }
   render::raster::Rasterizer rasterizer;
   render::oracle::ReferenceSceneCache cache(size_t{1} << 30);
-  render::pipeline::RenderContext context{.rasterizer = &rasterizer, .referenceCache = &cache};
+  render::pipeline::RenderContext context{
+      .rasterizer = &rasterizer, .referenceCache = &cache, .gpuTessellator = nullptr};
+  if (config.values) {
+    printAllValues(config, context);
+    return 0;
+  }
   std::printf("renderer: %s; %u hardware threads; %d x %d, S = %d; best of %d warm runs%s\n\n",
               rasterizer.device().renderer.c_str(), std::thread::hardware_concurrency(),
               config.size, config.size, config.supersample, config.repeat,
               config.crossCheck ? "; with the Embree subdivision cross-check" : "");
 
   std::printf(
-      "| mesh | faces | adaptive ms | reference ms | ratio | ref. triangles | tessellate | "
-      "BVH | primary rays | Newton+shade | S-mask rays | outline | cross-check | metrics ms | "
-      "cache hit ms | hit ratio | outlineHausdorffPx |\n");
+      "| mesh | faces | approx. triangles | plain ms | compared ms | ratio | approx+raster | "
+      "reference ms | metrics ms | ref. triangles | tessellate | BVH | primary rays | "
+      "Newton+shade | S-mask rays | outline | outlineHausdorffPx |\n");
   std::printf(
       "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const NamedMesh& m : loadMeshes(config)) {
     try {
       RenderJob job = adaptiveJob(m, config);
       RenderResult plain = bench::runBest(job, context, config.repeat);
-      double adaptiveMs = plain.timings.approxMs + plain.timings.rasterMs;
+      const double plainMs = plain.timings.totalMs;
       job.reference = true;
       RenderResult r = bench::runBest(job, context, config.repeat, [&] { cache.clear(); });
-      RenderResult hit = bench::runBest(job, context, config.repeat);  // the scene stays cached
       const render::oracle::ReferenceStats& st = *r.timings.reference;
       std::printf(
-          "| %s | %d | %.0f | %.0f | %.2f | %zu | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | "
-          "%.0f | %.0f | %.0f | %.2f | %.3f |\n",
-          m.name.c_str(), m.mesh.faceCount(), adaptiveMs, r.timings.referenceMs,
-          r.timings.referenceMs / adaptiveMs, st.triangles, st.tessellateMs, st.bvhMs, st.traceMs,
-          st.newtonMs, st.maskMs, st.outlineMs, r.timings.crossCheckMs, r.timings.metricsMs,
-          hit.timings.referenceMs, hit.timings.referenceMs / adaptiveMs,
+          "| %s | %d | %zu | %.0f | %.0f | %.2f | %.0f | %.0f | %.0f | %zu | %.0f | %.0f | %.0f | "
+          "%.0f | %.0f | %.0f | %.3f |\n",
+          m.name.c_str(), m.mesh.faceCount(), plain.stats.triangles, plainMs, r.timings.totalMs,
+          r.timings.totalMs / plainMs, r.timings.approxMs + r.timings.rasterMs,
+          r.timings.referenceMs, r.timings.metricsMs, st.triangles, st.tessellateMs, st.bvhMs,
+          st.traceMs, st.newtonMs, st.maskMs, st.outlineMs,
           r.metrics.silhouette->outlineHausdorffPx.value_or(-1));
     } catch (const std::exception& e) {
       std::printf("| %s | %d | failed: %s |\n", m.name.c_str(), m.mesh.faceCount(), e.what());

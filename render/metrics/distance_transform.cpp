@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/core/huge_pages.h"
 #include "render/metrics/metrics.h"
 
 namespace limn::render::metrics {
@@ -26,7 +27,9 @@ ColumnDistances::ColumnDistances(int width, int height) : width_(width), height_
     throw std::invalid_argument("distance transform: image height " + std::to_string(height) +
                                 " is outside 0.." + std::to_string(kMaxSide));
   }
-  distances_.reset(new uint16_t[static_cast<size_t>(width) * static_cast<size_t>(height)]);
+  const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+  distances_.reset(new uint16_t[count]);
+  adviseHugePages(distances_.get(), count * sizeof(uint16_t));
 }
 
 void ColumnDistances::compute(const uint8_t* pixels, uint8_t featureBits,

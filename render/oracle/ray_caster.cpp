@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "render/core/error.h"
+#include "render/core/huge_pages.h"
 #include "render/oracle/embree_device.h"
 
 namespace limn::render::oracle {
@@ -114,7 +115,8 @@ PixelRay pixelRay(const Camera& camera, double px, double py) {
 std::vector<PixelHit> castClosestHits(RTCScene scene, const Camera& camera, RayPacking packing,
                                       const CancelToken& cancel) {
   const int width = camera.width(), height = camera.height();
-  std::vector<PixelHit> hits(static_cast<size_t>(width) * height);
+  std::vector<PixelHit> hits;
+  assignOnHugePages(hits, static_cast<size_t>(width) * height, PixelHit{});
   forEachBand(height, cancel, [&](int y0, int y1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -265,7 +267,7 @@ Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
                           const std::vector<char>& refine, const std::vector<char>& coarse,
                           const CancelToken& cancel) {
   const int width = camera.width(), height = camera.height(), s = supersample;
-  Image mask(width * s, height * s, 1, 0.0f);
+  Image mask = imageOnHugePages(width * s, height * s, 1, 0.0f);
   forEachBand(height, cancel, [&](int y0, int y1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);

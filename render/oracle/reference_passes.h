@@ -12,6 +12,7 @@
 
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
+#include "render/core/huge_pages.h"
 #include "render/core/image.h"
 #include "render/core/passes.h"
 #include "render/core/shading.h"
@@ -33,15 +34,15 @@ struct PassImages {
   PassImages(ImageSet& set, const PassSelection& passes, int width, int height) {
     if (passes.color || passes.wireframe) {
       color = &set.passes[pass::kColor];
-      *color = Image(width, height, 4);
+      *color = imageOnHugePages(width, height, 4);
       for (size_t i = 0; i < color->pixels.size(); i += 4) {
         for (int c = 0; c < 3; ++c) color->pixels[i + c] = shading::kBackground[c];
         color->pixels[i + 3] = 0.0f;
       }
     }
-    if (passes.mask) mask = &(set.passes[pass::kMask] = Image(width, height, 1));
-    if (passes.depth) depth = &(set.passes[pass::kDepth] = Image(width, height, 1));
-    if (passes.normal) normal = &(set.passes[pass::kNormal] = Image(width, height, 3));
+    if (passes.mask) mask = &(set.passes[pass::kMask] = imageOnHugePages(width, height, 1));
+    if (passes.depth) depth = &(set.passes[pass::kDepth] = imageOnHugePages(width, height, 1));
+    if (passes.normal) normal = &(set.passes[pass::kNormal] = imageOnHugePages(width, height, 3));
   }
 
   void write(int x, int y, const SurfaceHit& hit, const Camera& camera) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "render/core/huge_pages.h"
 #include "render/core/shading.h"
 #include "render/raster/egl_context.h"
 #include "render/raster/framebuffer.h"
@@ -410,7 +411,7 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample,
                                       const CancelToken& cancel, ImageSet& out) {
   const Camera big = camera.scaled(supersample);
   const int width = big.width(), height = big.height();
-  Image covered(width, height, 1);
+  Image covered = imageOnHugePages(width, height, 1);  // 64 MiB at 4096^2: huge_pages.h
   const Mat4 viewProjection = multiply(big.projectionMatrix(), big.viewMatrix());
   const float one[4] = {1, 1, 1, 1};
   const float zero[4] = {0, 0, 0, 0};

@@ -834,5 +834,51 @@ TEST(CoverageDistance, NeedleNarrowerThanTheSamplesIsNotAGapInTheSilhouette) {
   EXPECT_NEAR(missing.hausdorffPx, sampled.hausdorffPx, 0.5 / kS);
 }
 
+// The search near each contour pixel must give exactly the transform's numbers: the same
+// integer squared distances, summed in the same order. Random blobs, shifted by 0 to 90 mask
+// pixels (past the 64 rows the search looks at, so it also hands some directions to the
+// transform), with and without the renderings' geometry.
+TEST(Silhouette, NearbySearchGivesTheTransformsNumbersExactly) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  constexpr int kS = 4, kSize = 96;
+  const Camera camera = pixelCamera(kSize, kSize);
+  for (int trial = 0; trial < 24; ++trial) {
+    const double shift = (trial % 6) * 18.0 / kS;  // output pixels
+    Image a(kSize * kS, kSize * kS, 1), b(kSize * kS, kSize * kS, 1);
+    std::vector<std::array<Vec2, 3>> trianglesA, trianglesB;
+    for (int blob = 0; blob < 3; ++blob) {
+      const double cx = 20 + unit(rng) * 50, cy = 20 + unit(rng) * 50, r = 3 + unit(rng) * 15;
+      const double rb = r * (0.97 + 0.06 * unit(rng));
+      for (int j = 0; j < kSize * kS; ++j) {
+        for (int i = 0; i < kSize * kS; ++i) {
+          const double x = (i + 0.5) / kS, y = (j + 0.5) / kS;
+          if (std::hypot(x - cx, y - cy) <= r) a.at(i, j) = 1.0f;
+          if (std::hypot(x - cx - shift, y - cy + 0.3 * shift) <= rb) b.at(i, j) = 1.0f;
+        }
+      }
+      trianglesA.push_back({Vec2{cx - r, cy - r}, Vec2{cx + r, cy - r}, Vec2{cx, cy + r}});
+      trianglesB.push_back(
+          {Vec2{cx - rb + shift, cy}, Vec2{cx + rb + shift, cy}, Vec2{cx + shift, cy + rb}});
+    }
+    const tessellate::TriangleMesh meshA = trianglesAt(camera, trianglesA);
+    const tessellate::TriangleMesh meshB = trianglesAt(camera, trianglesB);
+    const CoverageDistanceQuery geometryA = meshCoverageDistance(meshA, camera, kNever);
+    const CoverageDistanceQuery geometryB = meshCoverageDistance(meshB, camera, kNever);
+    for (bool withGeometry : {false, true}) {
+      SilhouetteGeometry geometry;
+      if (withGeometry) geometry = {.approximation = &geometryA, .reference = &geometryB};
+      const SilhouetteMetrics nearby =
+          compareSilhouettes(a, b, kS, CancelToken{}, geometry, ContourSearch::Nearby);
+      const SilhouetteMetrics full =
+          compareSilhouettes(a, b, kS, CancelToken{}, geometry, ContourSearch::FullTransform);
+      EXPECT_EQ(nearby.hausdorffPx, full.hausdorffPx) << "trial " << trial;
+      EXPECT_EQ(nearby.meanPx, full.meanPx) << "trial " << trial;
+      EXPECT_EQ(nearby.iou, full.iou);
+      EXPECT_EQ(nearby.mismatchPx, full.mismatchPx);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace limn::render::metrics
