@@ -15,7 +15,14 @@ best of 5 each, sampling excluded. Every one returns points placed by linear int
 crossed cell edges and the triangles; the VTK filters are asked for nothing more (no normals,
 gradients or scalars). Prints a Markdown table: times, speed ratios, triangle counts.
 
+Every timed process runs with glibc's malloc told to keep freed memory (GLIBC_TUNABLES below):
+on the development VM first touching fresh memory costs about 4 ms per MB, so with the default
+allocator each run's time depends on whether its buffers came back from the last run (VTK's
+Flying Edges allocates one byte per x edge, 47 MB at 360^3, which glibc always maps afresh).
+--default-malloc measures with the default allocator instead.
+
     /usr/bin/python3 bench/implicit_vs_peers.py [build/bin/implicit_bench] [--resolutions 80,120,360]
+                                                [--default-malloc]
 
 Installs what it needs (Debian python3-vtk9 and python3-skimage) when they are missing.
 """
@@ -28,6 +35,7 @@ import time
 
 SCENES = ["sphere_bite", "metaball_figure", "sphere_cylinder_cut"]
 RUNS = 5
+KEEP_FREED_MEMORY = "glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=17179869184"
 
 
 def ensure_packages():
@@ -104,7 +112,8 @@ def skimage_times(path, shape):
     import numpy as np
     from skimage import measure
     volume = np.fromfile(path, dtype=np.float32).reshape(shape)
-    return best_ms(lambda: len(measure.marching_cubes(volume, level=0.0)[1]))
+    ms, triangles = best_ms(lambda: len(measure.marching_cubes(volume, level=0.0)[1]))
+    return {"ms": ms, "triangles": triangles}
 
 
 def difference(theirs, ours):
@@ -117,9 +126,10 @@ def row(binary, scene, resolution, tmp):
     shape = grid["shape"]
     limn = {t: run_json([binary, "--march", scene, str(resolution), path, "--threads", str(t),
                          "--runs", str(RUNS)]) for t in (1, 2)}
-    vtk = {t: run_json([sys.executable, __file__, "--vtk", path, ",".join(map(str, shape)),
-                        str(t)]) for t in (1, 2)}
-    sk_ms, sk_triangles = skimage_times(path, shape)
+    peer = [sys.executable, __file__, path, ",".join(map(str, shape))]
+    vtk = {t: run_json(peer[:2] + ["--vtk"] + peer[2:] + [str(t)]) for t in (1, 2)}
+    sk = run_json(peer[:2] + ["--skimage"] + peer[2:])
+    sk_ms, sk_triangles = sk["ms"], sk["triangles"]
     ours = limn[1]["triangles"]
     assert limn[2]["triangles"] == ours
     cells = "x".join(str(n - 1) for n in reversed(shape))
@@ -136,19 +146,26 @@ def row(binary, scene, resolution, tmp):
 
 def main():
     args = sys.argv[1:]
-    if args and args[0] == "--vtk":
+    if args and args[0] in ("--vtk", "--skimage"):
         shape = [int(n) for n in args[2].split(",")]
-        print(json.dumps(vtk_times(args[1], shape, int(args[3]))))
+        times = vtk_times(args[1], shape, int(args[3])) if args[0] == "--vtk" else \
+            skimage_times(args[1], shape)
+        print(json.dumps(times))
         return
     ensure_packages()
     binary = "build/bin/implicit_bench"
     resolutions = [80, 120, 360]
+    allocator = "freed memory kept (GLIBC_TUNABLES=" + KEEP_FREED_MEMORY + ")"
     while args:
         arg = args.pop(0)
         if arg == "--resolutions":
             resolutions = [int(r) for r in args.pop(0).split(",")]
+        elif arg == "--default-malloc":
+            allocator = "glibc's default malloc"
         else:
             binary = arg
+    if allocator.startswith("freed"):
+        os.environ["GLIBC_TUNABLES"] = KEEP_FREED_MEMORY
     print("| scene | grid (cells) | sampling Mvoxels/s | limn 1 thread ms | limn 2 threads ms | "
           "Flying Edges 1 thread ms | Flying Edges 2 threads ms | vtkMarchingCubes ms | "
           "scikit-image ms | Flying Edges / limn, 1 thread | Flying Edges / limn, 2 threads | "
@@ -161,7 +178,7 @@ def main():
                 smp = row(binary, scene, resolution, tmp)
                 os.remove(f"{tmp}/{scene}_{resolution}.f32")
     print(f"\nVTK SMP backend {smp['backend']}, {smp['threads']} threads in the 2-thread runs; "
-          "triangle columns after limn's: the difference from limn's count.")
+          f"{allocator}; triangle columns after limn's: the difference from limn's count.")
 
 
 if __name__ == "__main__":

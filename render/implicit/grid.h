@@ -77,23 +77,31 @@ class SlabMarcher {
  private:
   struct Slab;
   struct CellRow;
-  class EdgeRanks;
+  struct EdgeRun;
   void classify(const Slab& slab);
   void count(const Slab& slab);
   void assignOffsets(const Slab& slab);
   void write(const Slab& slab);
-  void writeVertices(const Slab& slab, size_t r, bool withZ);
-  void writeTriangles(size_t r, EdgeRanks& ranks);
+  void writeXYVertices(const Slab& slab, size_t r);
+  void writeZVertices(const Slab& slab, size_t r);
+  void writeTriangles(size_t r);
+  bool uniform(size_t r, bool nextRow, bool nextLayer) const;
   CellRow cellRow(size_t r, bool withNeighbours) const;
 
   const Grid& grid_;
   RawMesh& out_;
-  int words_;                       // bit words per row of corners, one of them zero padding
-  std::vector<uint64_t> bits_;      // the slab's rows of inside bits
-  std::vector<uint32_t> xyVertex_;  // per row: its x and y edges' count, then first vertex
-  std::vector<uint32_t> zVertex_;   // per row: its z edges' count, then first vertex
-  std::vector<uint32_t> triangle_;  // per row: its row of cells' triangles, then first triangle
-  uint32_t layerVertex_ = 0;        // the first vertex of the next slab's first layer
+  int words_;                        // bit words per row of corners, one of them zero padding
+  std::vector<uint64_t> bits_;       // the slab's rows of inside bits
+  std::vector<uint32_t> xyVertex_;   // per row: its x and y edges' count, then first vertex
+  std::vector<uint32_t> zVertex_;    // per row: its z edges' count, then first vertex
+  std::vector<uint32_t> xVertices_;  // per row: its crossed x edges (its y vertices follow them)
+  std::vector<uint16_t> ranks_;      // per row, axis and word: the row's crossed edges before it
+  std::vector<uint32_t> triangle_;   // per row: its row of cells' triangles, then first triangle
+  enum : uint8_t { kXYVertices = 1, kZVertices = 2, kTriangles = 4 };
+  std::vector<uint8_t> work_;  // per row: what it has to write
+  enum : uint8_t { kAllOutside, kAllInside, kMixed };
+  std::vector<uint8_t> state_;  // per row: its corners all outside, all inside, or mixed
+  uint32_t layerVertex_ = 0;    // the first vertex of the next slab's first layer
 };
 
 // The vertices moved from their linear interpolation onto the surface (regula falsi on the

@@ -1,8 +1,5 @@
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -57,10 +54,18 @@ uint64_t insideBits(const float* values, int count) {
   uint64_t bits = 0;
   int b = 0;
 #if defined(__SSE2__)
+  // 16 corners per step: four compares packed to bytes, one movemask.
   const __m128 zero = _mm_setzero_ps();
+  auto inside = [&](int at) {
+    return _mm_castps_si128(_mm_cmpgt_ps(_mm_loadu_ps(values + at), zero));
+  };
+  for (; b + 16 <= count; b += 16) {
+    const __m128i low = _mm_packs_epi32(inside(b), inside(b + 4));
+    const __m128i high = _mm_packs_epi32(inside(b + 8), inside(b + 12));
+    bits |= static_cast<uint64_t>(_mm_movemask_epi8(_mm_packs_epi16(low, high))) << b;
+  }
   for (; b + 4 <= count; b += 4) {
-    const __m128 inside = _mm_cmpgt_ps(_mm_loadu_ps(values + b), zero);
-    bits |= static_cast<uint64_t>(_mm_movemask_ps(inside)) << b;
+    bits |= static_cast<uint64_t>(_mm_movemask_ps(_mm_castsi128_ps(inside(b)))) << b;
   }
 #endif
   for (; b < count; ++b) bits |= static_cast<uint64_t>(values[b] > 0.0f) << b;
@@ -155,37 +160,6 @@ struct SlabMarcher::CellRow {
   }
 };
 
-// The crossed edges around a row of cells as eight masks (x edges of rows a, b, c, d; y edges
-// of a and c; z edges of a and b), each with its first vertex and per-word ranks, so that the
-// vertex of a crossed edge is one popcount away.
-class SlabMarcher::EdgeRanks {
- public:
-  explicit EdgeRanks(int realWords)
-      : words_(realWords), masks_(8 * realWords), ranks_(8 * realWords) {}
-
-  template <typename Word>  // Word: uint64_t(int w)
-  void set(int m, uint32_t first, const Word& word) {
-    uint32_t rank = first;
-    for (int w = 0; w < words_; ++w) {
-      masks_[m * words_ + w] = word(w);
-      ranks_[m * words_ + w] = rank;
-      rank += bitCount(masks_[m * words_ + w]);
-    }
-    end_[m] = rank;
-  }
-  uint32_t end(int m) const { return end_[m]; }
-  uint32_t vertex(int m, int i) const {
-    const int at = m * words_ + (i >> 6);
-    return ranks_[at] + bitCount(masks_[at] & bitsBelow(i & 63));
-  }
-
- private:
-  int words_;
-  std::vector<uint64_t> masks_;
-  std::vector<uint32_t> ranks_;
-  uint32_t end_[8] = {};
-};
-
 struct SlabMarcher::Slab {
   int k0, k1;
   const float* values;
@@ -205,21 +179,14 @@ void SlabMarcher::march(int k0, int k1, const float* values) {
   xyVertex_.resize(slab.rows);
   zVertex_.resize(slab.rows);
   triangle_.resize(slab.rows);
-  auto t0 = std::chrono::steady_clock::now();
-  auto lap = [&](const char* what) {
-    auto t = std::chrono::steady_clock::now();
-    if (getenv("MC_TIMES"))
-      fprintf(stderr, "%s %.2f  ", what, std::chrono::duration<double, std::milli>(t - t0).count());
-    t0 = t;
-  };
+  work_.resize(slab.rows);
+  state_.resize(slab.rows);
+  xVertices_.resize(slab.rows);
+  ranks_.resize(slab.rows * 3 * (words_ - 1));
   classify(slab);
-  lap("classify");
   count(slab);
-  lap("count");
   assignOffsets(slab);
-  lap("offsets");
   write(slab);
-  lap("write");
 }
 
 void SlabMarcher::classify(const Slab& slab) {
@@ -228,8 +195,14 @@ void SlabMarcher::classify(const Slab& slab) {
     for (size_t r = begin; r < end; ++r) {
       const float* values = slab.values + r * nx;
       uint64_t* row = &bits_[r * words_];
-      for (int w = 0; w < words_; ++w)
-        row[w] = insideBits(values + 64 * w, std::clamp(nx - 64 * w, 0, 64));
+      uint64_t any = 0, all = ~uint64_t{0};
+      for (int w = 0; w < words_; ++w) {
+        const int count = std::clamp(nx - 64 * w, 0, 64);
+        row[w] = insideBits(values + 64 * w, count);
+        any |= row[w];
+        if (count > 0) all &= row[w] | ~bitsBelow(count - 1) << 1;  // count - 1: no shift by 64
+      }
+      state_[r] = any == 0 ? kAllOutside : ~all == 0 ? kAllInside : kMixed;
     }
   });
 }
@@ -243,6 +216,16 @@ SlabMarcher::CellRow SlabMarcher::cellRow(size_t r, bool withNeighbours) const {
   return {a, a + words_, a + layerWords, a + layerWords + words_, realWords, lastCells};
 }
 
+// Whether row r and the rows it reaches to (j + 1, k + 1, both) are all inside or all outside:
+// then it owns no crossed edge and its row of cells has no surface, and the row is not read.
+bool SlabMarcher::uniform(size_t r, bool nextRow, bool nextLayer) const {
+  const uint8_t state = state_[r];
+  const size_t ny = grid_.n[1] + 1;
+  return state != kMixed && (!nextRow || state_[r + 1] == state) &&
+         (!nextLayer || state_[r + ny] == state) &&
+         (!(nextRow && nextLayer) || state_[r + ny + 1] == state);
+}
+
 void SlabMarcher::count(const Slab& slab) {
   const int ny = grid_.n[1] + 1;
   const CaseTable& table = CaseTable::instance();
@@ -250,22 +233,40 @@ void SlabMarcher::count(const Slab& slab) {
     for (size_t r = begin; r < end; ++r) {
       const bool nextRow = static_cast<int>(r % ny) + 1 < ny;
       const bool nextLayer = static_cast<int>(r / ny) + 1 < slab.layers;
+      if (uniform(r, nextRow, nextLayer)) {
+        xyVertex_[r] = zVertex_[r] = triangle_[r] = 0;
+        work_[r] = 0;
+        continue;
+      }
       const uint64_t* a = &bits_[r * words_];
       const CellRow row = cellRow(r, nextRow && nextLayer);
-      uint32_t xy = 0, z = 0, triangles = 0;
+      uint16_t* rank = &ranks_[r * 3 * row.realWords];
+      uint32_t x = 0, y = 0, z = 0, triangles = 0;
       for (int w = 0; w < row.realWords; ++w) {
-        xy += bitCount(row.xEdges(a, w));
-        if (nextRow) xy += bitCount(a[w] ^ a[w + words_]);
-        if (nextLayer) z += bitCount(a[w] ^ a[w + (ny * words_)]);
+        rank[w] = static_cast<uint16_t>(x);
+        rank[w + row.realWords] = static_cast<uint16_t>(y);
+        rank[w + 2 * row.realWords] = static_cast<uint16_t>(z);
+        const uint64_t xEdges = row.xEdges(a, w), yEdges = nextRow ? a[w] ^ a[w + words_] : 0,
+                       zEdges = nextLayer ? a[w] ^ a[w + (ny * words_)] : 0;
+        // Most words of most rows cross nothing: test before counting.
+        if (xEdges | yEdges | zEdges) {
+          x += bitCount(xEdges);
+          y += bitCount(yEdges);
+          z += bitCount(zEdges);
+        }
         if (!(nextRow && nextLayer)) continue;
         forEachBit(row.surfaceCells(w), w, [&](int i) {
           const int c = row.configuration(i);
           triangles += (table.begin[c + 1] - table.begin[c]) / 3;
         });
       }
+      xVertices_[r] = x;
+      const uint32_t xy = x + y;
       xyVertex_[r] = xy;
       zVertex_[r] = z;
       triangle_[r] = triangles;
+      work_[r] = static_cast<uint8_t>((xy ? kXYVertices : 0) | (z ? kZVertices : 0) |
+                                      (triangles ? kTriangles : 0));
     }
   });
 }
@@ -303,69 +304,92 @@ void SlabMarcher::assignOffsets(const Slab& slab) {
 void SlabMarcher::write(const Slab& slab) {
   const int ny = grid_.n[1] + 1;
   parallelFor(slab.rows, 32, [&](size_t begin, size_t end) {
-    EdgeRanks ranks(words_ - 1);
     for (size_t r = begin; r < end; ++r) {
+      if (!work_[r]) continue;
       const bool nextLayer = static_cast<int>(r / ny) + 1 < slab.layers;
-      if (nextLayer || slab.last) writeVertices(slab, r, nextLayer);
-      if (nextLayer && static_cast<int>(r % ny) + 1 < ny) writeTriangles(r, ranks);
+      if ((work_[r] & kXYVertices) && (nextLayer || slab.last)) writeXYVertices(slab, r);
+      if (work_[r] & kZVertices) writeZVertices(slab, r);
+      if (work_[r] & kTriangles) writeTriangles(r);
     }
   });
 }
 
-// Row r's x and y vertices, and its z vertices when the slab holds the next layer.
-void SlabMarcher::writeVertices(const Slab& slab, size_t r, bool withZ) {
+// Row r's x and y vertices.
+void SlabMarcher::writeXYVertices(const Slab& slab, size_t r) {
   const int nx = grid_.n[0] + 1, ny = grid_.n[1] + 1;
   const int j = static_cast<int>(r % ny), k = slab.k0 + static_cast<int>(r / ny);
   const float* f = slab.values + r * nx;
   const uint64_t* a = &bits_[r * words_];
   const CellRow row = cellRow(r, false);
-  const size_t layer = static_cast<size_t>(ny) * nx;
   EdgeVertex* out = &out_.vertices[xyVertex_[r]];
   for (int w = 0; w < row.realWords; ++w) {
     forEachBit(row.xEdges(a, w), w, [&](int i) {
       *out++ = {grid_.corner(i, j, k), grid_.corner(i + 1, j, k), f[i], f[i + 1]};
     });
   }
-  if (j + 1 < ny) {
-    for (int w = 0; w < row.realWords; ++w) {
-      forEachBit(a[w] ^ a[w + words_], w, [&](int i) {
-        *out++ = {grid_.corner(i, j, k), grid_.corner(i, j + 1, k), f[i], f[i + nx]};
-      });
-    }
-  }
-  if (!withZ) return;
-  out = &out_.vertices[zVertex_[r]];
-  const size_t nextLayer = static_cast<size_t>(ny) * words_;
+  if (j + 1 == ny) return;
   for (int w = 0; w < row.realWords; ++w) {
-    forEachBit(a[w] ^ a[w + nextLayer], w, [&](int i) {
-      *out++ = {grid_.corner(i, j, k), grid_.corner(i, j, k + 1), f[i], f[i + layer]};
+    forEachBit(a[w] ^ a[w + words_], w, [&](int i) {
+      *out++ = {grid_.corner(i, j, k), grid_.corner(i, j + 1, k), f[i], f[i + nx]};
     });
   }
 }
 
+// Row r's z vertices (to the next layer).
+void SlabMarcher::writeZVertices(const Slab& slab, size_t r) {
+  const int nx = grid_.n[0] + 1, ny = grid_.n[1] + 1;
+  const int j = static_cast<int>(r % ny), k = slab.k0 + static_cast<int>(r / ny);
+  const float* f = slab.values + r * nx;
+  const uint64_t* a = &bits_[r * words_];
+  const size_t nextLayerBits = static_cast<size_t>(ny) * words_, nextLayer = size_t{1} * ny * nx;
+  EdgeVertex* out = &out_.vertices[zVertex_[r]];
+  for (int w = 0; w + 1 < words_; ++w) {
+    forEachBit(a[w] ^ a[w + nextLayerBits], w, [&](int i) {
+      *out++ = {grid_.corner(i, j, k), grid_.corner(i, j, k + 1), f[i], f[i + nextLayer]};
+    });
+  }
+}
+
+// The crossed edges of one axis that a row of corners owns: with its per-word ranks, the vertex
+// of the edge at corner i is one popcount away.
+struct SlabMarcher::EdgeRun {
+  const uint64_t* row;
+  const uint64_t* other;  // the row at the edges' other ends; null: the row's own x edges
+  const uint16_t* rank;   // per word: the run's crossed edges before it
+  uint32_t first;         // the run's first vertex
+
+  uint32_t vertex(int i) const {
+    const int w = i >> 6;
+    const uint64_t crossed = other ? row[w] ^ other[w] : row[w] ^ nextCorners(row, w);
+    return first + rank[w] + bitCount(crossed & bitsBelow(i & 63));
+  }
+};
+
 // The triangles of the row of cells above row r (between rows j, j + 1 and layers k, k + 1).
-void SlabMarcher::writeTriangles(size_t r, EdgeRanks& ranks) {
+void SlabMarcher::writeTriangles(size_t r) {
   const CellRow row = cellRow(r, true);
-  bool any = false;
-  for (int w = 0; w < row.realWords && !any; ++w) any = row.surfaceCells(w) != 0;
-  if (!any) return;
   const size_t ny = grid_.n[1] + 1, b = r + 1, c = r + ny, d = c + 1;
-  ranks.set(0, xyVertex_[r], [&](int w) { return row.xEdges(row.a, w); });
-  ranks.set(1, xyVertex_[b], [&](int w) { return row.xEdges(row.b, w); });
-  ranks.set(2, xyVertex_[c], [&](int w) { return row.xEdges(row.c, w); });
-  ranks.set(3, xyVertex_[d], [&](int w) { return row.xEdges(row.d, w); });
-  ranks.set(4, ranks.end(0), [&](int w) { return row.a[w] ^ row.b[w]; });
-  ranks.set(5, ranks.end(2), [&](int w) { return row.c[w] ^ row.d[w]; });
-  ranks.set(6, zVertex_[r], [&](int w) { return row.a[w] ^ row.c[w]; });
-  ranks.set(7, zVertex_[b], [&](int w) { return row.b[w] ^ row.d[w]; });
+  const int words = row.realWords;
+  auto ranks = [&](size_t of, int axis) { return &ranks_[(of * 3 + axis) * words]; };
+  // In the order of CaseTable::mask: x edges of rows a, b, c, d; y edges of a, c; z of a, b.
+  const EdgeRun runs[8] = {
+      {row.a, nullptr, ranks(r, 0), xyVertex_[r]},
+      {row.b, nullptr, ranks(b, 0), xyVertex_[b]},
+      {row.c, nullptr, ranks(c, 0), xyVertex_[c]},
+      {row.d, nullptr, ranks(d, 0), xyVertex_[d]},
+      {row.a, row.b, ranks(r, 1), xyVertex_[r] + xVertices_[r]},
+      {row.c, row.d, ranks(c, 1), xyVertex_[c] + xVertices_[c]},
+      {row.a, row.c, ranks(r, 2), zVertex_[r]},
+      {row.b, row.d, ranks(b, 2), zVertex_[b]},
+  };
   const CaseTable& table = CaseTable::instance();
   uint32_t* out = &out_.indices[3 * static_cast<size_t>(triangle_[r])];
-  for (int w = 0; w < row.realWords; ++w) {
+  for (int w = 0; w < words; ++w) {
     forEachBit(row.surfaceCells(w), w, [&](int i) {
       const int configuration = row.configuration(i);
       for (int e = table.begin[configuration]; e < table.begin[configuration + 1]; ++e) {
         const uint8_t edge = table.edges[e];
-        *out++ = ranks.vertex(table.mask[edge], i + table.dx[edge]);
+        *out++ = runs[table.mask[edge]].vertex(i + table.dx[edge]);
       }
     });
   }

@@ -152,7 +152,9 @@ void expectSameAsReference(const Samples& s, const std::string& what, bool touch
     EXPECT_TRUE(onOneBorderFace(s.grid, mesh.vertices[edge.first], mesh.vertices[edge.second]))
         << what << ": a hole inside the grid";
   }
-  if (!touchesBorder) EXPECT_EQ(borderEdges, 0u) << what;
+  if (!touchesBorder) {
+    EXPECT_EQ(borderEdges, 0u) << what;
+  }
 }
 
 float sphere(int i, int j, int k, Vec3 centre, double radius) {
