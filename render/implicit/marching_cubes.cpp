@@ -110,6 +110,7 @@ void forEachBit(uint64_t word, int w, const Visit& visit) {
 // eight edge masks of a row of cells (CellRow) and its x offset from the cell's corner 0.
 struct CaseTable {
   uint16_t begin[257];
+  uint16_t crossed[256];  // the cube edges the configuration's triangles use
   std::vector<uint8_t> edges;
   uint8_t mask[12], dx[12];
 
@@ -124,6 +125,8 @@ struct CaseTable {
     for (int c = 0; c < 256; ++c) {
       begin[c] = static_cast<uint16_t>(edges.size());
       edges.insert(edges.end(), cubes.triangles(c).begin(), cubes.triangles(c).end());
+      crossed[c] = 0;
+      for (uint8_t e : cubes.triangles(c)) crossed[c] |= static_cast<uint16_t>(1u << e);
     }
     begin[256] = static_cast<uint16_t>(edges.size());
     for (int e = 0; e < 12; ++e) {
@@ -387,9 +390,14 @@ void SlabMarcher::writeTriangles(size_t r) {
   for (int w = 0; w < words; ++w) {
     forEachBit(row.surfaceCells(w), w, [&](int i) {
       const int configuration = row.configuration(i);
+      // Each crossed edge's vertex once, then the triangles from them.
+      uint32_t vertex[12];
+      for (uint32_t edges = table.crossed[configuration]; edges; edges &= edges - 1) {
+        const int edge = __builtin_ctz(edges);
+        vertex[edge] = runs[table.mask[edge]].vertex(i + table.dx[edge]);
+      }
       for (int e = table.begin[configuration]; e < table.begin[configuration + 1]; ++e) {
-        const uint8_t edge = table.edges[e];
-        *out++ = runs[table.mask[edge]].vertex(i + table.dx[edge]);
+        *out++ = vertex[table.edges[e]];
       }
     });
   }
