@@ -86,6 +86,7 @@ class SlabMarcher {
   void writeZVertices(const Slab& slab, size_t r);
   void writeTriangles(size_t r);
   bool uniform(size_t r, bool nextRow, bool nextLayer) const;
+  size_t rowsPerTask() const;
   CellRow cellRow(size_t r, bool withNeighbours) const;
 
   const Grid& grid_;

@@ -244,13 +244,15 @@ TEST(SlabMarcher, SurfaceCutByTheBorder) {
 }
 
 TEST(SlabMarcher, SameMeshOnOneAndTwoThreads) {
-  // Wavy sheets through the whole grid: enough rows with surface for both threads to take part.
-  Samples s(90, 70, 50, [](int i, int j, int k) {
+  // Wavy sheets through the whole grid. The marcher hands out rows about 2^18 corners at a time:
+  // at 129 corners a row, slabs of 16 layers and more are at least two tasks, so both threads
+  // take part.
+  Samples s(128, 128, 64, [](int i, int j, int k) {
     return std::sin(0.31f * i) + std::sin(0.23f * j + 0.4f) + std::sin(0.27f * k + 0.1f * i);
   });
-  const EdgeMesh one = slabMarch(s, 50, 1);
-  ASSERT_GT(one.indices.size(), 30000u);
-  for (int slab : {50, 16, 7}) {
+  const EdgeMesh one = slabMarch(s, 64, 1);
+  ASSERT_GT(one.indices.size(), 100000u);
+  for (int slab : {64, 32, 16}) {
     const EdgeMesh two = slabMarch(s, slab, 2);
     EXPECT_EQ(two.indices, one.indices) << "slabs of " << slab;
     EXPECT_EQ(two.vertices, one.vertices) << "slabs of " << slab;
