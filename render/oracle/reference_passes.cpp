@@ -98,23 +98,28 @@ void castSupersampledMask(RTCScene scene, const Camera& camera, const std::vecto
 
 std::vector<int> edgePixels(const std::vector<PixelHit>& hits, int width, int height) {
   constexpr double kDepthJump = 0.05;
-  std::vector<int> edges;
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
-      bool edge = false;
-      for (int dy = -1; dy <= 1 && !edge; ++dy) {
-        for (int dx = -1; dx <= 1 && !edge; ++dx) {
-          const int u = x + dx, v = y + dy;
-          if (u < 0 || v < 0 || u >= width || v >= height) continue;
-          const PixelHit& g = hits[static_cast<size_t>(v) * width + u];
-          edge = g.hit() != h.hit() ||
-                 (h.hit() && std::fabs(g.t - h.t) > kDepthJump * std::min(g.t, h.t));
+  // Rows in parallel, joined in row order: the same list as one pass over the image.
+  std::vector<std::vector<int>> rowEdges(height);
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y) {
+      for (int x = 0; x < width; ++x) {
+        const PixelHit& h = hits[static_cast<size_t>(y) * width + x];
+        bool edge = false;
+        for (int dy = -1; dy <= 1 && !edge; ++dy) {
+          for (int dx = -1; dx <= 1 && !edge; ++dx) {
+            const int u = x + dx, v = y + dy;
+            if (u < 0 || v < 0 || u >= width || v >= height) continue;
+            const PixelHit& g = hits[static_cast<size_t>(v) * width + u];
+            edge = g.hit() != h.hit() ||
+                   (h.hit() && std::fabs(g.t - h.t) > kDepthJump * std::min(g.t, h.t));
+          }
         }
+        if (edge) rowEdges[y].push_back(y * width + x);
       }
-      if (edge) edges.push_back(y * width + x);
     }
-  }
+  });
+  std::vector<int> edges;
+  for (const std::vector<int>& row : rowEdges) edges.insert(edges.end(), row.begin(), row.end());
   return edges;
 }
 

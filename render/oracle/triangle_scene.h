@@ -5,6 +5,9 @@
 // shared edges, so the coverage of a watertight mesh has no pinholes) and a chosen BVH quality.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "render/oracle/embree_device.h"
 #include "render/tessellate/triangle_mesh.h"
 
@@ -14,6 +17,8 @@ namespace limn::render::oracle {
 // occlusion rays: LOW 39 / 54 / 496 ms, MEDIUM 158 / 52 / 396 ms, HIGH 138 / 46 / 393 ms. The
 // reference now casts the supersampled mask only near outlines (about 0.1M rays at 1024^2), so
 // every caller builds at LOW; HIGH would pay only for full 4096^2 casts.
-EmbreeScene buildTriangleScene(const tessellate::TriangleMesh& mesh, RTCBuildQuality quality);
+// `only` (optional): the triangles to put in the scene, by index; every triangle otherwise.
+EmbreeScene buildTriangleScene(const tessellate::TriangleMesh& mesh, RTCBuildQuality quality,
+                               const std::vector<uint32_t>* only = nullptr);
 
 }  // namespace limn::render::oracle
