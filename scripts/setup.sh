@@ -35,7 +35,8 @@ if [ "$profile" = full ]; then
     # scripts/fuzz.sh), Prometheus' text-format parser and a JSON Schema validator (the /metrics
     # and OpenAPI tests), the load generator
     clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-prometheus-client python3-jsonschema wrk
-    # the implicit-surface benchmark's baseline (bench/implicit_vs_skimage.py)
+    # the implicit-surface benchmark's baseline (bench/implicit_vs_peers.py, which installs
+    # python3-vtk9 itself: no test needs VTK)
     python3-skimage
     # limn batch's plots (scripts/batch_plots.py, run by /usr/bin/python3)
     python3-matplotlib
