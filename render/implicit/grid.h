@@ -97,6 +97,7 @@ class SlabMarcher {
   std::vector<uint32_t> zVertex_;    // per row: its z edges' count, then first vertex
   std::vector<uint32_t> xVertices_;  // per row: its crossed x edges (its y vertices follow them)
   std::vector<uint16_t> ranks_;      // per row, axis and word: the row's crossed edges before it
+                                     // (16 bits: rows of at most 65,535 corners, checked)
   std::vector<uint32_t> triangle_;   // per row: its row of cells' triangles, then first triangle
   enum : uint8_t { kXYVertices = 1, kZVertices = 2, kTriangles = 4 };
   std::vector<uint8_t> work_;  // per row: what it has to write

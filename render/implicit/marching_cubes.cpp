@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -172,7 +173,10 @@ struct SlabMarcher::Slab {
 };
 
 SlabMarcher::SlabMarcher(const Grid& grid, RawMesh& out)
-    : grid_(grid), out_(out), words_((grid.n[0] + 1 + 63) / 64 + 1) {}
+    : grid_(grid), out_(out), words_((grid.n[0] + 1 + 63) / 64 + 1) {
+  if (grid.n[0] + 1 > UINT16_MAX)
+    throw std::length_error("marching cubes: rows over 65,535 corners");
+}
 
 void SlabMarcher::march(int k0, int k1, const float* values) {
   const int layers = k1 - k0 + 1;
