@@ -1,14 +1,18 @@
-// reference_bench: where the exact reference spends its time, stage by stage, next to the
-// adaptive approximation (dicingRate 1) of the same request measured in the same run, on the
-// project's own dense meshes and the corpus shapes over ~500 faces (the corpus has none today;
-// --shapes adds any). Prints Markdown (bench/reference_results.md keeps the last run).
+// reference_bench: what a comparison (`reference: true`) costs next to the plain render of the
+// same request (adaptive, dicingRate 1), measured in the same run, stage by stage: on the
+// project's own dense meshes (pawn, torus, bumpy ball, a Loop creature, a 5k-face creature, an
+// 80k-face torus), make_models.py's models (--model-dir, --models) and corpus shapes (--shapes).
+// Prints Markdown (bench/reference_results.md keeps the runs).
 //
-//   reference_bench [--size 1024] [--supersample 4] [--repeat 3] [--corpus DIR] [--shapes a,b]
+//   reference_bench [--size 1024] [--supersample 4] [--repeat 3] [--only prefix,...]
+//                   [--model-dir DIR --models a,b] [--corpus DIR --shapes a,b] [--cross-check]
+//   reference_bench --values ...   every metric of 3 views x 3 methods per mesh, exactly
 //
-// Each row is the best of --repeat warm runs. "adaptive ms" is approximation + raster of the
-// request without a reference; "ratio" is referenceMs / adaptive ms; the stage columns split
-// referenceMs (ms); "cache hit ms" is referenceMs when the tessellation and BVH come from the
-// reference cache (the same request again).
+// Each row is the best (totalMs) of --repeat warm runs. "plain ms" is totalMs without the
+// reference (approximation + raster, colour only; no encoding); "compared ms" is totalMs with it
+// (the approximation's extra passes and 4096^2 mask, the reference, the metrics), every run
+// building its reference scene anew (the cache emptied); "ratio" is compared / plain. The
+// reference columns split referenceMs, the metrics columns metricsMs (ms).
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -204,9 +208,11 @@ int main(int argc, char** argv) {
   std::printf(
       "| mesh | faces | approx. triangles | plain ms | compared ms | ratio | approx+raster | "
       "reference ms | metrics ms | ref. triangles | tessellate | BVH | primary rays | "
-      "Newton+shade | S-mask rays | outline | outlineHausdorffPx |\n");
+      "Newton+shade | S-mask rays | outline | mask metrics | outline metrics | image metrics | "
+      "geometry | outlineHausdorffPx |\n");
   std::printf(
-      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+      "---:|---:|---:|\n");
   for (const NamedMesh& m : loadMeshes(config)) {
     try {
       RenderJob job = adaptiveJob(m, config);
@@ -215,14 +221,16 @@ int main(int argc, char** argv) {
       job.reference = true;
       RenderResult r = bench::runBest(job, context, config.repeat, [&] { cache.clear(); });
       const render::oracle::ReferenceStats& st = *r.timings.reference;
+      const render::metrics::MetricsTimings mt =
+          r.timings.metricsStages.value_or(render::metrics::MetricsTimings{});
       std::printf(
           "| %s | %d | %zu | %.0f | %.0f | %.2f | %.0f | %.0f | %.0f | %zu | %.0f | %.0f | %.0f | "
-          "%.0f | %.0f | %.0f | %.3f |\n",
+          "%.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.3f |\n",
           m.name.c_str(), m.mesh.faceCount(), plain.stats.triangles, plainMs, r.timings.totalMs,
           r.timings.totalMs / plainMs, r.timings.approxMs + r.timings.rasterMs,
           r.timings.referenceMs, r.timings.metricsMs, st.triangles, st.tessellateMs, st.bvhMs,
-          st.traceMs, st.newtonMs, st.maskMs, st.outlineMs,
-          r.metrics.silhouette->outlineHausdorffPx.value_or(-1));
+          st.traceMs, st.newtonMs, st.maskMs, st.outlineMs, mt.silhouetteMs, mt.outlineMs,
+          mt.imageMs, mt.geometryMs, r.metrics.silhouette->outlineHausdorffPx.value_or(-1));
     } catch (const std::exception& e) {
       std::printf("| %s | %d | failed: %s |\n", m.name.c_str(), m.mesh.faceCount(), e.what());
     }

@@ -36,6 +36,14 @@ struct GeometryMetrics {
   double maxDist = 0, meanDist = 0, relMaxDist = 0, relMeanDist = 0;
 };
 
+// Where the time of measuring one approximation against its reference went (milliseconds), for
+// timings and benchmarks: the mask metrics (with their geometry distance queries), locating the
+// approximation's outline and comparing it with the reference's, colour, depth and normal
+// metrics, and the geometry metrics.
+struct MetricsTimings {
+  double silhouetteMs = 0, outlineMs = 0, imageMs = 0, geometryMs = 0;
+};
+
 struct Metrics {
   std::optional<SilhouetteMetrics> silhouette;
   std::optional<ColorMetrics> image;

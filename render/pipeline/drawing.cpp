@@ -290,11 +290,14 @@ PassSelection referencePasses(bool measured, int supersample) {
 
 metrics::Metrics measureDrawing(MethodDrawing& drawing, const oracle::ReferenceResult& reference,
                                 const subdiv::LimitSurface& surface, const Camera& camera,
-                                int supersample, bool diff, const CancelToken& cancel) {
+                                int supersample, bool diff, const CancelToken& cancel,
+                                metrics::MetricsTimings* timings) {
   metrics::Metrics m = measureImages(drawing.approx.mesh, drawing.images, camera, supersample,
-                                     reference, surface.bounds().diagonal(), diff, cancel);
+                                     reference, surface.bounds().diagonal(), diff, cancel, timings);
+  Stopwatch clock;
   // Silhouette meshes live on the pre-subdivided copy: the same limit surface, finer faces.
   m.geometry = metrics::measureGeometry(drawing.approx.mesh, drawing.approx.drawnOn(surface));
+  if (timings) timings->geometryMs = clock.lapMs();
   return m;
 }
 

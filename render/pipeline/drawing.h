@@ -110,9 +110,11 @@ std::optional<std::string> antialiasWarning(RenderContext& context, const Output
 // Every metric of `drawing` (measured) against `reference` (hinted with its mask, alone or
 // merged with others: oracle::maskBlocks), and the geometric error against the limit surface.
 // With `diff`, the heat map goes into drawing.images and its scale into the colour metrics.
+// `timings` (optional) gets the time of each group of metrics.
 metrics::Metrics measureDrawing(MethodDrawing& drawing, const oracle::ReferenceResult& reference,
                                 const subdiv::LimitSurface& surface, const Camera& camera,
-                                int supersample, bool diff, const CancelToken& cancel);
+                                int supersample, bool diff, const CancelToken& cancel,
+                                metrics::MetricsTimings* timings = nullptr);
 
 // The checks of one method's params and shading against `limits` (InputError naming the
 // parameter, e.g. "params.level").

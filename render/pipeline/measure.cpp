@@ -5,13 +5,16 @@
 #include <string>
 
 #include "render/metrics/metrics.h"
+#include "render/pipeline/job_checks.h"
 
 namespace limn::render::pipeline {
 
 metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet& images,
                                const Camera& camera, int S,
                                const oracle::ReferenceResult& reference, double diagonal, bool diff,
-                               const CancelToken& cancel) {
+                               const CancelToken& cancel, metrics::MetricsTimings* timings) {
+  metrics::MetricsTimings spent;
+  Stopwatch clock;
   const ImageSet& refImages = reference.images;
   // Both geometries, so that features narrower than the samples count as what they are.
   const metrics::CoverageDistanceQuery approxGeometry =
@@ -26,6 +29,7 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
   m.silhouette =
       metrics::compareSilhouettes(images.supersampledMask, refImages.supersampledMask, S, cancel,
                                   {.approximation = &approxGeometry, .reference = toReference});
+  spent.silhouetteMs = clock.lapMs();
   // The reference was hinted with this mask: its refined pixels hold all of its outline.
   metrics::Outline outline = oracle::locateMeshOutline(approx, camera, images.supersampledMask, S,
                                                        cancel, &reference.refinedPixels);
@@ -34,6 +38,7 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
       toReference);
   m.silhouette->outlineHausdorffPx = d.hausdorffPx;
   m.silhouette->outlineMeanPx = d.meanPx;
+  spent.outlineMs = clock.lapMs();
   m.image = metrics::compareColor(images, refImages);
   // A surface without extent (every control point at one place: a valid mesh, drawn as a dot)
   // has no diagonal to measure depth against: its relative depth differences are 0, as
@@ -47,6 +52,8 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
     m.image->diffScale = heat.scale;
     images.passes[pass::kDiff] = std::move(heat.image);
   }
+  spent.imageMs = clock.lapMs();
+  if (timings) *timings = spent;
   return m;
 }
 

@@ -17,11 +17,13 @@ namespace limn::render::pipeline {
 // `images` (the approximation's passes at supersample S) against `reference` (cast with the
 // approximation's mask as its hint, alone or merged with others': oracle::maskBlocks):
 // silhouette metrics with the continuous outline distances, colour, depth (relative to
-// `diagonal`) and normal metrics; with `diff`, the heat map goes into `images`.
+// `diagonal`) and normal metrics; with `diff`, the heat map goes into `images`. `timings`
+// (optional) gets the time of each group.
 metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet& images,
                                const Camera& camera, int S,
                                const oracle::ReferenceResult& reference, double diagonal, bool diff,
-                               const CancelToken& cancel);
+                               const CancelToken& cancel,
+                               metrics::MetricsTimings* timings = nullptr);
 
 // The same into result.metrics, for result.images.
 void measureAgainstReference(const tessellate::TriangleMesh& approx, const Camera& camera, int S,

@@ -180,6 +180,8 @@ struct Timings {
   // referenceMs split by stage (when a reference was made); crossCheckMs is part of referenceMs.
   std::optional<oracle::ReferenceStats> reference;
   double crossCheckMs = 0;
+  // metricsMs split by group of metrics (when an approximation was measured).
+  std::optional<metrics::MetricsTimings> metricsStages;
 };
 
 struct RenderResult {

@@ -185,8 +185,10 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     cancel.check();
 
     if (measure) {
-      result.metrics =
-          measureDrawing(*drawing, reference, surface, camera, S, job.outputs.diff, cancel);
+      metrics::MetricsTimings stages;
+      result.metrics = measureDrawing(*drawing, reference, surface, camera, S, job.outputs.diff,
+                                      cancel, &stages);
+      result.timings.metricsStages = stages;
       if (auto note = referenceAccuracyNote(result.metrics, reference.stats)) {
         result.warnings.push_back(*note);
       }

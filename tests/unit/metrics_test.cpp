@@ -19,6 +19,7 @@
 #include "render/metrics/coverage_distance.h"
 #include "render/metrics/outline.h"
 #include "render/subdiv/limit_surface.h"
+#include "render/tessellate/tessellate.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::metrics {
@@ -877,6 +878,73 @@ TEST(Silhouette, NearbySearchGivesTheTransformsNumbersExactly) {
       EXPECT_EQ(nearby.iou, full.iou);
       EXPECT_EQ(nearby.mismatchPx, full.mismatchPx);
     }
+  }
+}
+
+// measureGeometry evaluates each vertex once and each edge midpoint shared by two triangles
+// once; the numbers must be those of evaluating all seven points of every triangle, as the
+// definition reads. The oracle here does that, summing per 4096 triangles and then the chunks,
+// the order measureGeometry sums in, so the two must agree exactly. Dense adaptive
+// tessellations (many chunks), Catmull-Clark with triangles, n-gons and creases, and Loop.
+TEST(Geometry, SharedPointsMeasuredOnceGiveTheSevenPointDefinitionExactly) {
+  const double weights[7][3] = {{1, 0, 0},
+                                {0, 1, 0},
+                                {0, 0, 1},
+                                {.5, .5, 0},
+                                {0, .5, .5},
+                                {.5, 0, .5},
+                                {1. / 3, 1. / 3, 1. / 3}};
+  for (const mesh::ControlMesh& cage :
+       {testing::creature(6), testing::loopCreature(5), testing::pawn(), testing::prism(7)}) {
+    const subdiv::LimitSurface surface(cage);
+    const Camera camera(Vec3{0.7, 1.1, 4.0}, Vec3{0, 0, 0}, Vec3{0, 1, 0}, 35,
+                        Projection::Perspective, 2, 384, 384, 0.01, 100);
+    tessellate::AdaptiveOptions options;
+    options.dicingRate = 1.5;
+    const tessellate::TriangleMesh mesh =
+        tessellate::tessellateAdaptive(surface, camera, options, {});
+    ASSERT_GT(mesh.triangleCount(), 3 * 4096u);
+    double max = 0, sum = 0, chunkSum = 0;
+    size_t count = 0;
+    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+      if (t % 4096 == 0) {
+        sum += chunkSum;
+        chunkSum = 0;
+      }
+      const int face = mesh.triangleFaces[t];
+      if (!surface.hasLimit(face)) continue;
+      const OpenSubdiv::Bfr::Parameterization param = surface.parameterization(face);
+      bool oneSubFace = true;
+      if (param.HasSubFaces()) {
+        int sub[3];
+        for (int k = 0; k < 3; ++k) {
+          const float uv[2] = {mesh.cornerUVs[3 * t + k].x, mesh.cornerUVs[3 * t + k].y};
+          sub[k] = param.GetSubFace(uv);
+        }
+        oneSubFace = sub[0] == sub[1] && sub[1] == sub[2];
+      }
+      for (int i = 0; i < (oneSubFace ? 7 : 3); ++i) {
+        const double* w = weights[i];
+        Vec3 corner[3];
+        Vec2f uv[3];
+        for (int k = 0; k < 3; ++k) {
+          corner[k] = mesh.positions[mesh.indices[3 * t + k]].toDouble();
+          uv[k] = mesh.cornerUVs[3 * t + k];
+        }
+        const Vec3 onTriangle =
+            i < 3 ? corner[i] : corner[0] * w[0] + corner[1] * w[1] + corner[2] * w[2];
+        const double u = i < 3 ? uv[i].x : w[0] * uv[0].x + w[1] * uv[1].x + w[2] * uv[2].x;
+        const double v = i < 3 ? uv[i].y : w[0] * uv[0].y + w[1] * uv[1].y + w[2] * uv[2].y;
+        const double d = length(onTriangle - surface.position(face, u, v));
+        max = std::max(max, d);
+        chunkSum += d;
+        ++count;
+      }
+    }
+    sum += chunkSum;
+    const GeometryMetrics m = measureGeometry(mesh, surface);
+    EXPECT_EQ(m.maxDist, max);
+    EXPECT_EQ(m.meanDist, sum / static_cast<double>(count));
   }
 }
 
