@@ -18,15 +18,6 @@ int segmentsFor(double sagPx, const ChordOptions& options) {
   return std::clamp(n, 2, std::max(2, options.maxSegments));
 }
 
-// How far `chordPoint` lies outside the surface at `sample`, in pixels (0 when inside).
-// `outward`: LimitSurface::outwardSign of the sample's face.
-double outsidePixels(const Camera& camera, const Vec3& chordPoint,
-                     const subdiv::LimitSample& sample, int outward) {
-  if (outward * dot(chordPoint - sample.position, sample.normal) <= 0) return 0;
-  Vec3 a = camera.project(chordPoint), b = camera.project(sample.position);
-  return std::hypot(a.x - b.x, a.y - b.y);
-}
-
 void sortByT(std::vector<EdgePoint>& points) {
   std::sort(points.begin(), points.end(),
             [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
@@ -38,7 +29,7 @@ void sortByT(std::vector<EdgePoint>& points) {
 // not, with at most options.maxSegments points on the edge. True when it added any.
 template <typename Evaluate>
 bool halveOutsideSegments(const Camera& camera, const Vec3& first, const Vec3& last,
-                          const Evaluate& at, int outward, const ChordOptions& options,
+                          const Evaluate& at, int side, const ChordOptions& options,
                           std::vector<EdgePoint>& points) {
   bool added = false;
   for (size_t i = 0; i <= points.size();) {
@@ -50,7 +41,7 @@ bool halveOutsideSegments(const Camera& camera, const Vec3& first, const Vec3& l
     const double t = 0.5 * (t0 + t1);
     const subdiv::LimitSample middle = at(t);
     if (t1 - t0 < 1e-4 ||
-        outsidePixels(camera, 0.5 * (p0 + p1), middle, outward) <= options.tolerancePx) {
+        outsidePixels(camera, 0.5 * (p0 + p1), middle, side) <= options.tolerancePx) {
       ++i;
       continue;
     }
@@ -60,6 +51,14 @@ bool halveOutsideSegments(const Camera& camera, const Vec3& first, const Vec3& l
   return added;
 }
 }  // namespace
+
+double outsidePixels(const Camera& camera, const Vec3& chordPoint,
+                     const subdiv::LimitSample& sample, int side) {
+  const double offset = dot(chordPoint - sample.position, sample.normal);
+  if (side == 0 ? offset == 0 : side * offset <= 0) return 0;
+  Vec3 a = camera.project(chordPoint), b = camera.project(sample.position);
+  return std::hypot(a.x - b.x, a.y - b.y);
+}
 
 std::vector<bool> contourFaces(const subdiv::LimitSurface& surface, const ContourSearch& search) {
   const Far::TopologyLevel& base = surface.baseLevel();
@@ -123,7 +122,7 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
         return domains.evaluate(owner, edgeUV(domains, owner, static_cast<int>(e), t));
       };
       int segments = segmentsFor(outsidePixels(camera, 0.5 * (limit[ends[0]] + limit[ends[1]]),
-                                               at(0.5), surface.outwardSign(owner)),
+                                               at(0.5), outsideSide(surface, owner)),
                                  options);
       if (segments >= 2) {
         out.edgeRates[e] = segments;
@@ -134,7 +133,7 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
         sortByT(points);
       }
       if (halveOutsideSegments(camera, limit[ends[0]], limit[ends[1]], at,
-                               surface.outwardSign(owner), options, points)) {
+                               outsideSide(surface, owner), options, points)) {
         out.edgeRates[e] = std::max(out.edgeRates[e], 2);
       }
     }
@@ -149,7 +148,7 @@ ChordRefinement refineConcaveChords(const FaceDomains& domains, const Camera& ca
     for (int v : verts) centroid += limit[v];
     centroid = centroid / static_cast<double>(verts.size());
     int rate = segmentsFor(outsidePixels(camera, centroid, domains.evaluate(f, domains.center(f)),
-                                         surface.outwardSign(f)),
+                                         outsideSide(surface, f)),
                            options);
     for (int e : base.GetFaceEdges(f)) rate = std::max(rate, out.edgeRates[e]);
     if (rate < 2) continue;

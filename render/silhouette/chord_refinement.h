@@ -7,7 +7,8 @@
 // gets uniform points along its limit curve, enough to bring the chord's sag under the tolerance
 // (sag falls with the square of the segment count); such ring faces whose centre lies outside
 // the surface likewise get interior points. Chords inside the surface (convex regions) stay:
-// the exact contour curves already bound the outline there.
+// the exact contour curves already bound the outline there. An open piece has no inside: both
+// its sides are checked.
 #pragma once
 
 #include <vector>
@@ -17,6 +18,19 @@
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::silhouette {
+
+// Which side of a face's surface a chord must not lie on: outside a closed piece (its
+// LimitSurface::outwardSign), and either side of an open one (0), whose two sides can both be
+// seen; the inner wall of a thin open shell (a bottle's neck seen from the side) bulges out
+// through the outer wall where its chords span its concave flare.
+inline int outsideSide(const subdiv::LimitSurface& surface, int face) {
+  return surface.hiddenSide(face) != 0 ? surface.outwardSign(face) : 0;
+}
+
+// How far `chordPoint` lies on the `side` (outsideSide) of the surface at `sample`, in pixels
+// (0 when on the other side).
+double outsidePixels(const Camera& camera, const Vec3& chordPoint,
+                     const subdiv::LimitSample& sample, int side);
 
 struct ChordOptions {
   double tolerancePx = 0.1;

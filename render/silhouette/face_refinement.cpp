@@ -7,6 +7,8 @@
 #include <set>
 #include <utility>
 
+#include "render/silhouette/chord_refinement.h"
+
 namespace limn::render::silhouette {
 
 namespace {
@@ -56,19 +58,16 @@ int refineFaceTriangles(const FaceDomains& domains, const Camera& camera, int fa
     for (size_t i = 0; i + 1 < chain.size(); ++i) locked.insert(key(chain[i], chain[i + 1]));
   }
 
-  // How far the chord a-b lies outside the surface at its middle, in pixels (0 if inside); the
-  // limit normals of an inside-out piece point in.
-  const int outward = domains.surface().outwardSign(face);
+  // How far the chord a-b lies outside the surface at its middle, in pixels (0 if inside;
+  // outsideSide).
+  const int side = outsideSide(domains.surface(), face);
   auto sag = [&](int a, int b, FacePoint* middle) {
     const FacePoint& pa = points[a];
     const FacePoint& pb = points[b];
     Vec2 uv{0.5 * (pa.uv.x + pb.uv.x), 0.5 * (pa.uv.y + pb.uv.y)};
     subdiv::LimitSample s = domains.evaluate(face, uv);
     *middle = {uv, s.position, s.normal};
-    Vec3 chord = 0.5 * (pa.position + pb.position);
-    if (outward * dot(chord - s.position, s.normal) <= 0) return 0.0;
-    Vec3 c = camera.project(chord), m = camera.project(s.position);
-    return std::hypot(c.x - m.x, c.y - m.y);
+    return outsidePixels(camera, 0.5 * (pa.position + pb.position), s, side);
   };
 
   // A split must leave the triangulation a tiling of the same domain; if numerical trouble

@@ -130,6 +130,21 @@ TEST(ThinFold, AHairpinContourInsideTheOutlineLeavesNoHoles) {
   EXPECT_LE(m.outlinePx, 1.0) << m.warnings;
 }
 
+// An open shell seen from the side: the bottle (Loop) turns in at its lip and runs back down
+// inside, a thin wall. Its inner wall's chords span the neck's concave flare on the side away
+// from its normals, which on a closed piece is the hidden inside; on an open one it is the outer
+// wall, and they poked through it: 2.39 px at 512^2 (4.8 px at 1024^2). Open pieces now have
+// their chords checked on both sides.
+TEST(OpenShell, AThinWallsInnerChordsDoNotPokeThroughTheOuterWall) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  Measured m = render(
+      server, meshJson(corpusDir() / "bottle.obj", "loop"), R"("method": "silhouette")",
+      R"({"eye": [-0.7866572, 2.3008163, -3.0494492], "target": [0, 0.77, 0], "up": [0, 1, 0],
+          "projection": "orthographic", "orthoHeight": 1.8911094, "width": 512, "height": 512})");
+  ASSERT_EQ(m.status, 200) << m.body;
+  EXPECT_LE(m.outlinePx, 1.0) << m.warnings;
+}
+
 // Pieces wound inside-out (every face clockwise seen from outside: their limit normals point
 // in), common in production models. The methods cull the side of a closed piece that faces away
 // from the eye, and the silhouette method's concave correction asks which side of the surface
