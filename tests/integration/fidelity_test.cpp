@@ -145,6 +145,41 @@ TEST(OpenShell, AThinWallsInnerChordsDoNotPokeThroughTheOuterWall) {
   EXPECT_LE(m.outlinePx, 1.0) << m.warnings;
 }
 
+// N-gon fans next to poles: the fish's decagon caps (Catmull-Clark, a flattened tube) and the
+// flower's valence-12 poles and hexagon cap (Loop), from views that see the caps and poles at
+// the outline. One comparison per view measures every method against one reference.
+TEST(NGonsAndPoles, EveryMethodIsWithinTargetAroundCapsAndPoles) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  const struct {
+    const char *model, *scheme, *camera;
+  } views[] = {
+      {"fish", "catmull-clark",
+       R"({"eye": [1.6, 0.4, 0.9], "target": [0, 0, 0], "fovYDeg": 35, "width": 512,
+           "height": 512})"},
+      {"flower", "loop",
+       R"({"eye": [-1.0, 0.4, -1.4], "target": [0, 0.5, 0], "fovYDeg": 40, "width": 512,
+           "height": 512})"},
+  };
+  for (const auto& view : views) {
+    const std::string body =
+        R"({"mesh": )" + meshJson(corpusDir() / (std::string(view.model) + ".obj"), view.scheme) +
+        R"(, "cameras": [)" + view.camera +
+        R"(], "methods": [{"method": "adaptive", "params": {"dicingRate": 1}},
+                          {"method": "silhouette"},
+                          {"method": "patches", "params": {"dicingRate": 1}}]})";
+    HttpResponse r = post(server.port(), "/v1/compare", body);
+    ASSERT_EQ(r.status, 200) << r.body.substr(0, 600);
+    rapidjson::Document doc = parseJson(r.body);
+    const double targets[] = {0.5, 1.0, 1.0};  // adaptive, silhouette, patches (issue 26)
+    ASSERT_EQ(doc["rows"].Size(), 3u);
+    for (rapidjson::SizeType k = 0; k < 3; ++k) {
+      const auto& row = doc["rows"][k];
+      EXPECT_LE(row["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble(), targets[k])
+          << view.model << " " << row["method"].GetString();
+    }
+  }
+}
+
 // Pieces wound inside-out (every face clockwise seen from outside: their limit normals point
 // in), common in production models. The methods cull the side of a closed piece that faces away
 // from the eye, and the silhouette method's concave correction asks which side of the surface
