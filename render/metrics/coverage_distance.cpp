@@ -2,6 +2,9 @@
 // samples the sampled distances put more than a sample away from the other outline), the
 // triangles many (a reference has up to millions), so the points go into a grid, each in every
 // cell its search disc reaches, and every triangle visits the cells under its bounding box.
+// The triangles are filed by image-plane bucket once per query, so each batch of points visits
+// only the triangles near its grid (a batch along an outline: a few percent of them) instead of
+// passing over all of them.
 #include "render/metrics/coverage_distance.h"
 
 #include <tbb/blocked_range.h>
@@ -51,6 +54,14 @@ class PointGrid {
     }
   }
 
+  // The rectangle the cells cover: a triangle whose box misses it visits no cell.
+  void extent(double* xa, double* ya, double* xb, double* yb) const {
+    *xa = x0_;
+    *ya = y0_;
+    *xb = x0_ + nx_ * cell_;
+    *yb = y0_ + ny_ * cell_;
+  }
+
   // Calls `visit` with every cell overlapping the box (clipped to the grid).
   template <typename Visit>
   void forCells(double xa, double ya, double xb, double yb, Visit&& visit) {
@@ -75,8 +86,99 @@ struct Nearest {
   std::vector<char> covered;
 };
 
-// The mesh's vertices in the image plane, projected on the query's first call and kept for
-// the next (lowerLargestFirst calls it once per batch).
+// The triangles in front of the near plane filed by the image-plane cell of their box's lower
+// corner (cells of kBucketPx), so that a batch of points visits only the triangles that can
+// reach its grid: the visits, and so the distances, are those of a pass over every triangle
+// (a triangle whose box misses the points' grid visits none of its cells), at the cost of one
+// pass for the whole query instead of one per batch. Triangles wider or taller than kBucketPx
+// are listed apart and always visited.
+class TriangleBuckets {
+ public:
+  static constexpr double kBucketPx = 32;
+
+  void build(const tessellate::TriangleMesh& mesh, const std::vector<Vec2>& projected,
+             const std::vector<char>& inFront) {
+    const size_t triangles = mesh.indices.size() / 3;
+    // The lower corner of triangle t's box; whether it is small (false: large, NaN or behind).
+    auto lowerCorner = [&](size_t t, double* xa, double* ya) {
+      const uint32_t* c = &mesh.indices[3 * t];
+      if (!inFront[c[0]] || !inFront[c[1]] || !inFront[c[2]]) return false;
+      const Vec2 &a = projected[c[0]], &b = projected[c[1]], &d = projected[c[2]];
+      *xa = std::min({a.x, b.x, d.x});
+      *ya = std::min({a.y, b.y, d.y});
+      const double xb = std::max({a.x, b.x, d.x}), yb = std::max({a.y, b.y, d.y});
+      return xb - *xa <= kBucketPx && yb - *ya <= kBucketPx;
+    };
+    double x0 = std::numeric_limits<double>::max(), y0 = x0, x1 = -x0, y1 = -x0;
+    for (size_t t = 0; t < triangles; ++t) {
+      double xa, ya;
+      if (!lowerCorner(t, &xa, &ya)) {
+        const uint32_t* c = &mesh.indices[3 * t];
+        if (inFront[c[0]] && inFront[c[1]] && inFront[c[2]]) {
+          large_.push_back(static_cast<uint32_t>(t));
+        }
+        continue;
+      }
+      x0 = std::min(x0, xa);
+      y0 = std::min(y0, ya);
+      x1 = std::max(x1, xa);
+      y1 = std::max(y1, ya);
+      small_.push_back(static_cast<uint32_t>(t));
+    }
+    if (small_.empty()) return;
+    x0_ = x0;
+    y0_ = y0;
+    nx_ = static_cast<int>((x1 - x0) / kBucketPx) + 1;
+    ny_ = static_cast<int>((y1 - y0) / kBucketPx) + 1;
+    // Counting sort of the small triangles by bucket (ascending triangle order within one).
+    start_.assign(static_cast<size_t>(nx_) * ny_ + 1, 0);
+    std::vector<uint32_t> bucketOf(small_.size());
+    for (size_t k = 0; k < small_.size(); ++k) {
+      double xa, ya;
+      lowerCorner(small_[k], &xa, &ya);
+      bucketOf[k] = static_cast<uint32_t>(bucket(xa, ya));
+      ++start_[bucketOf[k] + 1];
+    }
+    for (size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+    std::vector<uint32_t> sorted(small_.size());
+    std::vector<uint32_t> next(start_.begin(), start_.end() - 1);
+    for (size_t k = 0; k < small_.size(); ++k) sorted[next[bucketOf[k]]++] = small_[k];
+    small_ = std::move(sorted);
+  }
+
+  // Every triangle whose box can meet [xa, xb] x [ya, yb] (and some that cannot).
+  std::vector<uint32_t> near(double xa, double ya, double xb, double yb) const {
+    std::vector<uint32_t> out = large_;
+    if (small_.empty()) return out;
+    // A small triangle's lower corner lies at most kBucketPx below-left of any point of it.
+    const int i0 = std::max(0, static_cast<int>(std::floor((xa - kBucketPx - x0_) / kBucketPx)));
+    const int j0 = std::max(0, static_cast<int>(std::floor((ya - kBucketPx - y0_) / kBucketPx)));
+    const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((xb - x0_) / kBucketPx)));
+    const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((yb - y0_) / kBucketPx)));
+    for (int j = j0; j <= j1; ++j) {
+      if (i0 > i1) break;
+      const size_t first = start_[static_cast<size_t>(j) * nx_ + i0];
+      const size_t last = start_[static_cast<size_t>(j) * nx_ + i1 + 1];
+      out.insert(out.end(), small_.begin() + first, small_.begin() + last);
+    }
+    return out;
+  }
+
+ private:
+  size_t bucket(double x, double y) const {
+    const int i = std::min(nx_ - 1, static_cast<int>((x - x0_) / kBucketPx));
+    const int j = std::min(ny_ - 1, static_cast<int>((y - y0_) / kBucketPx));
+    return static_cast<size_t>(j) * nx_ + i;
+  }
+
+  double x0_ = 0, y0_ = 0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<uint32_t> small_, large_;
+  std::vector<size_t> start_;  // small_[start_[b], start_[b + 1]) lie in bucket b
+};
+
+// The mesh's vertices in the image plane and its triangles' buckets, made on the query's first
+// call and kept for the next (lowerLargestFirst calls it once per batch).
 struct ProjectedMesh {
   const tessellate::TriangleMesh& mesh;
   const Camera& camera;
@@ -84,6 +186,7 @@ struct ProjectedMesh {
   std::once_flag once;
   std::vector<Vec2> projected;
   std::vector<char> inFront;  // in front of the near plane
+  TriangleBuckets buckets;
 
   void project() {
     const size_t vertexCount = mesh.positions.size();
@@ -98,6 +201,7 @@ struct ProjectedMesh {
                           inFront[v] = p.z > camera.nearPlane();
                         }
                       });
+    buckets.build(mesh, projected, inFront);
   }
 };
 
@@ -115,13 +219,15 @@ void lowerToMeshDistances(ProjectedMesh& projection, const std::vector<Vec2>& po
   tbb::enumerable_thread_specific<Nearest> nearest([&] {
     return Nearest{distances, std::vector<char>(points.size(), 0)};
   });
-  const size_t triangles = mesh.indices.size() / 3;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, kTriangleGrain),
+  double gx0, gy0, gx1, gy1;
+  grid.extent(&gx0, &gy0, &gx1, &gy1);
+  const std::vector<uint32_t> candidates = projection.buckets.near(gx0, gy0, gx1, gy1);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), kTriangleGrain),
                     [&](const tbb::blocked_range<size_t>& range) {
                       if (cancel.expired()) return;
                       Nearest& mine = nearest.local();
-                      for (size_t t = range.begin(); t < range.end(); ++t) {
-                        const uint32_t* corner = &mesh.indices[3 * t];
+                      for (size_t i = range.begin(); i < range.end(); ++i) {
+                        const uint32_t* corner = &mesh.indices[3 * size_t{candidates[i]}];
                         if (!inFront[corner[0]] || !inFront[corner[1]] || !inFront[corner[2]]) {
                           continue;
                         }
