@@ -948,5 +948,57 @@ TEST(Geometry, SharedPointsMeasuredOnceGiveTheSevenPointDefinitionExactly) {
   }
 }
 
+// The query visits only the triangles filed near each batch's points; its distances must be
+// those of measuring every triangle: small triangles, large ones (listed apart), points near
+// bucket borders and off the image, bounds small and large.
+TEST(CoverageDistance, MatchesEveryTriangleOnRandomMeshes) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Camera camera = pixelCamera(256, 256);
+  std::vector<std::array<Vec2, 3>> triangles;
+  for (int t = 0; t < 3000; ++t) {
+    const double size = t % 100 == 0 ? 150 : 12;
+    const Vec2 a{unit(rng) * 300 - 20, unit(rng) * 300 - 20};
+    triangles.push_back({a, Vec2{a.x + size * unit(rng), a.y + size * unit(rng)},
+                         Vec2{a.x - size * unit(rng), a.y + size * unit(rng)}});
+  }
+  const tessellate::TriangleMesh mesh = trianglesAt(camera, triangles);
+  std::vector<Vec2> corners(mesh.positions.size());
+  for (size_t v = 0; v < corners.size(); ++v) {
+    const Vec3 p = camera.project(mesh.positions[v].toDouble());
+    corners[v] = {p.x, p.y};
+  }
+  std::vector<Vec2> points;
+  std::vector<double> bounds;
+  for (int k = 0; k < 600; ++k) {
+    points.push_back({unit(rng) * 280 - 12, unit(rng) * 280 - 12});
+    bounds.push_back(k % 3 == 0 ? 60 * unit(rng) : 4 * unit(rng));
+  }
+  std::vector<double> expected = bounds;
+  for (size_t k = 0; k < points.size(); ++k) {
+    double nearest = bounds[k];
+    bool covered = false;
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      const double d =
+          pointTriangleDistance(points[k], corners[3 * t], corners[3 * t + 1], corners[3 * t + 2]);
+      covered = covered || d == 0;
+      nearest = std::min(nearest, d);
+    }
+    if (!covered) expected[k] = nearest;
+  }
+  const CoverageDistanceQuery query = meshCoverageDistance(mesh, camera, kNever);
+  std::vector<double> measured = bounds;
+  query(points, measured);
+  for (size_t k = 0; k < points.size(); ++k) EXPECT_EQ(measured[k], expected[k]) << k;
+  // Batches of a few points, as lowerLargestFirst sends them: the same answers.
+  for (size_t k = 0; k < points.size(); k += 7) {
+    std::vector<Vec2> few(points.begin() + k, points.begin() + std::min(points.size(), k + 7));
+    std::vector<double> fewBounds(bounds.begin() + k,
+                                  bounds.begin() + std::min(points.size(), k + 7));
+    query(few, fewBounds);
+    for (size_t i = 0; i < few.size(); ++i) EXPECT_EQ(fewBounds[i], expected[k + i]) << k + i;
+  }
+}
+
 }  // namespace
 }  // namespace limn::render::metrics
