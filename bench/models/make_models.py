@@ -585,6 +585,43 @@ def scarf(rng):
     return m, ["long open sheet folded", "edge-on folds"]
 
 
+# ---- dense scenes: several parts of the models above in one mesh (5,000-20,000 faces) ----
+
+def placed(parts, mesh=None):
+    """One mesh of several (mesh, turn about y in radians, offset) parts, as a scene file holds
+    many objects in one mesh."""
+    out = mesh or Mesh()
+    for part, turn, offset in parts:
+        base = len(out.points)
+        c, s = math.cos(turn), math.sin(turn)
+        for x, y, z in part.points:
+            out.add_point((c * x + s * z + offset[0], y + offset[1], -s * x + c * z + offset[2]))
+        for f in part.faces:
+            out.add_face([v + base for v in f])
+        for a, b, sharpness in part.creases:
+            out.crease(a + base, b + base, sharpness)
+    return out
+
+
+def crowd(rng):
+    people = [(humanoid(rng, sides=16)[0], rng.uniform(-0.6, 0.6), (1.1 * (k % 2) - 0.55, 0, 1.2 * (k // 2)))
+              for k in range(4)]
+    return placed(people), ["four figures: poles, thin fingers side by side", "n-gon caps", "6,000+ faces"]
+
+
+def grove(rng):
+    plants = [(plant(rng)[0], rng.uniform(0, 6.3), (0.9 * k - 0.9, 0, 0.3 * (k % 2))) for k in range(3)]
+    return placed(plants), ["three plants: leaves as open sheets overlapping", "sub-pixel tendrils",
+                            "5,000+ faces"]
+
+
+def workshop(rng):
+    parts = [(gear(rng, teeth=48)[0], 0.3 * k, (2.05 * (k % 3) - 2.05, 0.25 * (k // 3), 2.1 * (k // 3)))
+             for k in range(9)]
+    parts += [(bolt(rng)[0], 0.0, (0.7 * k - 2.1, 0, -1.5)) for k in range(7)]
+    return placed(parts), ["gears and bolts: infinitely sharp rims", "hexagon caps", "5,000+ faces"]
+
+
 MODELS = [
     # name, function, category, scheme, held out
     ("humanoid", humanoid, "character", "catmull-clark", False),
@@ -617,6 +654,9 @@ MODELS = [
     ("hat", hat, "garment", "catmull-clark", False),
     ("sandal", sandal, "garment", "catmull-clark", False),
     ("scarf", scarf, "garment", "loop", False),
+    ("crowd", crowd, "scene", "catmull-clark", False),
+    ("grove", grove, "scene", "catmull-clark", False),
+    ("workshop", workshop, "scene", "catmull-clark", True),
 ]
 
 MIN_FACES, MAX_FACES = 500, 20000
