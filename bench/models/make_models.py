@@ -616,9 +616,10 @@ def grove(rng):
 
 
 def workshop(rng):
-    parts = [(gear(rng, teeth=48)[0], 0.3 * k, (2.05 * (k % 3) - 2.05, 0.25 * (k // 3), 2.1 * (k // 3)))
+    # 16 teeth: 64-gon caps, the largest face limn takes by default (limits.maxFaceSize).
+    parts = [(gear(rng, teeth=16)[0], 0.3 * k, (2.05 * (k % 3) - 2.05, 0.25 * (k // 3), 2.1 * (k // 3)))
              for k in range(9)]
-    parts += [(bolt(rng)[0], 0.0, (0.7 * k - 2.1, 0, -1.5)) for k in range(7)]
+    parts += [(bolt(rng)[0], 0.0, (0.7 * (k % 5) - 1.4, 0, -1.5 - 0.7 * (k // 5))) for k in range(10)]
     return placed(parts), ["gears and bolts: infinitely sharp rims", "hexagon caps", "5,000+ faces"]
 
 
