@@ -90,30 +90,34 @@ Measured render(const ServerProcess& server, const std::string& mesh, const std:
 
 const std::string kPawn = std::string(LIMN_SOURCE_DIR) + "/examples/pawn.obj";
 
+// One render of `mesh` by `method` from `camera` on a fresh one-worker server, its outline
+// distance to the reference at most `targetPx`.
+void expectOutlineWithin(const std::string& mesh, const std::string& method,
+                         const std::string& camera, double targetPx) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  Measured m = render(server, mesh, method, camera);
+  ASSERT_EQ(m.status, 200) << m.body;
+  EXPECT_LE(m.outlinePx, targetPx) << m.warnings;
+}
+
 // Concave profiles: the pawn's neck from the default view. Faces just behind the silhouette
 // face away and were culled to one segment per edge; their chords lie outside a concave
 // surface and poked past the outline by 1.04 px at 1024^2, at any dicing rate.
 TEST(AdaptiveOutline, ChordsBehindAConcaveSilhouetteDoNotPokeOut) {
-  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
-  Measured m =
-      render(server, meshJson(kPawn), R"("method": "adaptive", "params": {"dicingRate": 1})",
-             R"({"width": 1024, "height": 1024})");
-  ASSERT_EQ(m.status, 200) << m.body;
-  EXPECT_LE(m.outlinePx, 0.5) << m.warnings;
+  expectOutlineWithin(meshJson(kPawn), R"("method": "adaptive", "params": {"dicingRate": 1})",
+                      R"({"width": 1024, "height": 1024})", 0.5);
 }
 
 // Foreshortened edges at a silhouette: the humanoid's lathed head seen from below and in front.
 // Its ring edges run towards the eye at the head's sides, so they project to a fraction of a
 // pixel and were diced once, yet bulge by their whole sag in the image: 0.68 px at 512^2.
 TEST(AdaptiveOutline, EdgesSeenEndOnAtASilhouetteAreDicedAsIfFaceOn) {
-  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
-  Measured m = render(
-      server, meshJson(corpusDir() / "humanoid.obj"),
+  expectOutlineWithin(
+      meshJson(corpusDir() / "humanoid.obj"),
       R"("method": "adaptive", "params": {"dicingRate": 1})",
       R"({"eye": [-0.0461363, 0.1280192, 4.6157623], "target": [0, 0.419, 0], "up": [0, 1, 0],
-          "fovYDeg": 41.2249182, "width": 512, "height": 512})");
-  ASSERT_EQ(m.status, 200) << m.body;
-  EXPECT_LE(m.outlinePx, 0.5) << m.warnings;
+          "fovYDeg": 41.2249182, "width": 512, "height": 512})",
+      0.5);
 }
 
 // A fold thinner than its contours' chord error: the ribbed cactus seen nearly along a rib. A
@@ -121,13 +125,11 @@ TEST(AdaptiveOutline, EdgesSeenEndOnAtASilhouetteAreDicedAsIfFaceOn) {
 // sampled legs crossed in the image, and with the fold's hidden triangles culled a dotted line
 // of pixels inside the body went uncovered: 22 px at 512^2 (44 px at 1024^2).
 TEST(ThinFold, AHairpinContourInsideTheOutlineLeavesNoHoles) {
-  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
-  Measured m =
-      render(server, meshJson(corpusDir() / "cactus.obj"), R"("method": "silhouette")",
-             R"({"eye": [-0.5395722, 1.3172251, 2.6654705], "target": [0, 0.6, 0], "up": [0, 1, 0],
-          "fovYDeg": 20.5226957, "width": 512, "height": 512})");
-  ASSERT_EQ(m.status, 200) << m.body;
-  EXPECT_LE(m.outlinePx, 1.0) << m.warnings;
+  expectOutlineWithin(
+      meshJson(corpusDir() / "cactus.obj"), R"("method": "silhouette")",
+      R"({"eye": [-0.5395722, 1.3172251, 2.6654705], "target": [0, 0.6, 0], "up": [0, 1, 0],
+          "fovYDeg": 20.5226957, "width": 512, "height": 512})",
+      1.0);
 }
 
 // An open shell seen from the side: the bottle (Loop) turns in at its lip and runs back down
@@ -136,13 +138,11 @@ TEST(ThinFold, AHairpinContourInsideTheOutlineLeavesNoHoles) {
 // wall, and they poked through it: 2.39 px at 512^2 (4.8 px at 1024^2). Open pieces now have
 // their chords checked on both sides.
 TEST(OpenShell, AThinWallsInnerChordsDoNotPokeThroughTheOuterWall) {
-  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
-  Measured m = render(
-      server, meshJson(corpusDir() / "bottle.obj", "loop"), R"("method": "silhouette")",
+  expectOutlineWithin(
+      meshJson(corpusDir() / "bottle.obj", "loop"), R"("method": "silhouette")",
       R"({"eye": [-0.7866572, 2.3008163, -3.0494492], "target": [0, 0.77, 0], "up": [0, 1, 0],
-          "projection": "orthographic", "orthoHeight": 1.8911094, "width": 512, "height": 512})");
-  ASSERT_EQ(m.status, 200) << m.body;
-  EXPECT_LE(m.outlinePx, 1.0) << m.warnings;
+          "projection": "orthographic", "orthoHeight": 1.8911094, "width": 512, "height": 512})",
+      1.0);
 }
 
 // N-gon fans next to poles: the fish's decagon caps (Catmull-Clark, a flattened tube) and the
