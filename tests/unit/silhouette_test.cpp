@@ -2,6 +2,7 @@
 // limit surface, local re-triangulation, pre-subdivision.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -191,6 +192,52 @@ TEST(ContourSearch, FindsALoopInsideOneFaceAndTessellatesIt) {
   EXPECT_GE(inLoopFace, 32u);
   // From higher up the whole bump faces the eye: no loop.
   EXPECT_TRUE(searchContour(domains, bumpView(45), {}, CancelToken()).loopFaces.empty());
+}
+
+// A gear: two 64-gon caps whose rims (infinitely sharp) follow 16 teeth, and the quads of its
+// side. Each cap is flat, so it holds no contour from any view.
+ControlMesh gear() {
+  ControlMesh m;
+  const int n = 64;
+  for (int y : {0, 1}) {
+    for (int k = 0; k < n; ++k) {
+      const double r = (k / 2) % 2 == 0 ? 1.0 : 0.85, a = 2 * M_PI * k / n;
+      m.points.push_back({r * std::cos(a), 0.2 * y, -r * std::sin(a)});
+    }
+  }
+  std::vector<int> bottom, top;
+  for (int k = 0; k < n; ++k) {
+    addFace(m, {k, (k + 1) % n, n + (k + 1) % n, n + k});
+    m.creases.push_back({k, (k + 1) % n, 10.0f});
+    m.creases.push_back({n + k, n + (k + 1) % n, 10.0f});
+    bottom.push_back(n - 1 - k);
+    top.push_back(n + k);
+  }
+  for (const std::vector<int>* cap : {&bottom, &top}) {
+    m.faceVertexCounts.push_back(n);
+    m.faceVertexIndices.insert(m.faceVertexIndices.end(), cap->begin(), cap->end());
+  }
+  return m;
+}
+
+// At a reflex corner of a flat cap (between two teeth) Bfr's normal at the corner itself is the
+// cross product of derivatives that turn by more than 180 degrees: it pointed out of the other
+// side of the cap, the edge search saw g change sign along the rim, and the cap's triangulation
+// along those false curves spanned the gaps between the teeth (20 px on a scene of gears seen
+// from below).
+TEST(ContourSearch, AFlatCapWithAConcaveRimHoldsNoContour) {
+  subdiv::LimitSurface surface(gear());
+  const FaceDomains domains(surface);
+  // Below the gear, looking up at its bottom cap.
+  const Camera camera({-0.9, -4.0, 1.2}, {0, 0.1, 0}, {0, 1, 0}, 30, Projection::Perspective, 1,
+                      1024, 1024, 0.1, 100);
+  ContourSearch search = searchContour(domains, camera, {}, CancelToken());
+  const int n = 64;
+  for (int cap : {n, n + 1}) {
+    const FaceBoundary boundary = faceBoundary(domains, search, cap);
+    EXPECT_EQ(std::count(boundary.crossing.begin(), boundary.crossing.end(), true), 0)
+        << "cap " << cap;
+  }
 }
 
 TEST(ContourSearch, ExactCurvesLieOnTheContour) {
