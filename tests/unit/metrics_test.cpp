@@ -450,6 +450,16 @@ struct TriangleMeshBuilder {
 // Float positions put every vertex up to ~1e-7 (relative) off the surface.
 constexpr double kFloatNoise = 1e-6;
 
+// The points measureGeometry measures on each triangle (DESIGN.md): barycentric weights of its
+// corners, edge midpoints and centroid.
+constexpr double kSevenPoints[7][3] = {{1, 0, 0},
+                                       {0, 1, 0},
+                                       {0, 0, 1},
+                                       {.5, .5, 0},
+                                       {0, .5, .5},
+                                       {.5, 0, .5},
+                                       {1. / 3, 1. / 3, 1. / 3}};
+
 TEST(Geometry, FlatFaceIsMeasuredExactlyAtInterpolatedParameters) {
   // On a flat, uniform grid the Catmull-Clark limit of an interior face is the bilinear map of
   // its corners, so triangles of limit points lie on the surface at the barycentric blend of
@@ -488,15 +498,8 @@ TEST(Geometry, ChordsOfACurvedFaceLeaveTheSurfaceAndShrinkWithRefinement) {
 
   // The largest of the seven samples, worked out here independently.
   double worst = 0;
-  const double weights[7][3] = {{1, 0, 0},
-                                {0, 1, 0},
-                                {0, 0, 1},
-                                {.5, .5, 0},
-                                {0, .5, .5},
-                                {.5, 0, .5},
-                                {1. / 3, 1. / 3, 1. / 3}};
   for (size_t t = 0; t < coarse.mesh.triangleCount(); ++t) {
-    for (const auto& w : weights) {
+    for (const auto& w : kSevenPoints) {
       Vec3 p{0, 0, 0};
       double u = 0, v = 0;
       for (int k = 0; k < 3; ++k) {
@@ -887,13 +890,6 @@ TEST(Silhouette, NearbySearchGivesTheTransformsNumbersExactly) {
 // the order measureGeometry sums in, so the two must agree exactly. Dense adaptive
 // tessellations (many chunks), Catmull-Clark with triangles, n-gons and creases, and Loop.
 TEST(Geometry, SharedPointsMeasuredOnceGiveTheSevenPointDefinitionExactly) {
-  const double weights[7][3] = {{1, 0, 0},
-                                {0, 1, 0},
-                                {0, 0, 1},
-                                {.5, .5, 0},
-                                {0, .5, .5},
-                                {.5, 0, .5},
-                                {1. / 3, 1. / 3, 1. / 3}};
   for (const mesh::ControlMesh& cage :
        {testing::creature(6), testing::loopCreature(5), testing::pawn(), testing::prism(7)}) {
     const subdiv::LimitSurface surface(cage);
@@ -924,7 +920,7 @@ TEST(Geometry, SharedPointsMeasuredOnceGiveTheSevenPointDefinitionExactly) {
         oneSubFace = sub[0] == sub[1] && sub[1] == sub[2];
       }
       for (int i = 0; i < (oneSubFace ? 7 : 3); ++i) {
-        const double* w = weights[i];
+        const double* w = kSevenPoints[i];
         Vec3 corner[3];
         Vec2f uv[3];
         for (int k = 0; k < 3; ++k) {
