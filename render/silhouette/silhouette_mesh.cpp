@@ -109,35 +109,39 @@ int loopRate(const FaceDomains& domains, const Camera& camera, int face) {
 constexpr double kBackFacingCos = 1e-3;
 constexpr double kFoldSliverPx = 1.0;
 
-double imageDistancePx(const Camera& camera, const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 pp = camera.project(p), pa = camera.project(a), pb = camera.project(b);
-  const double dx = pb.x - pa.x, dy = pb.y - pa.y, len2 = dx * dx + dy * dy;
+// Distance from p to the segment [a, b], all in the image plane.
+double segmentDistancePx(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
   const double t =
-      len2 > 0 ? std::clamp(((pp.x - pa.x) * dx + (pp.y - pa.y) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(pa.x + t * dx - pp.x, pa.y + t * dy - pp.y);
+      len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+  return std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
 }
 
-// Whether a point of curve `a` lies within kFoldSliverPx of a segment of curve `b` that does not
-// end at that point (`a` and `b` may be one curve: a hairpin whose legs nearly meet).
-bool curvesCloseInImage(const Camera& camera, const ContourCurve& a, const ContourCurve& b) {
+// Whether a point of polyline `a` lies within kFoldSliverPx of a segment of polyline `b` that
+// does not end at that point (`a` and `b` may be one curve: a hairpin whose legs nearly meet).
+bool curvesCloseInImage(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
   const bool same = &a == &b;
-  for (size_t i = 0; i < a.points.size(); ++i) {
-    for (size_t k = 0; k + 1 < b.points.size(); ++k) {
+  for (size_t i = 0; i < a.size(); ++i) {
+    for (size_t k = 0; k + 1 < b.size(); ++k) {
       if (same && (k + 1 >= i && k <= i)) continue;  // segments through point i
-      if (imageDistancePx(camera, a.points[i].position, b.points[k].position,
-                          b.points[k + 1].position) < kFoldSliverPx) {
-        return true;
-      }
+      if (segmentDistancePx(a[i], b[k], b[k + 1]) < kFoldSliverPx) return true;
     }
   }
   return false;
 }
 
 bool hasThinFold(const Camera& camera, const std::vector<ContourCurve>& curves) {
+  std::vector<std::vector<Vec2>> projected(curves.size());
   for (size_t i = 0; i < curves.size(); ++i) {
-    for (size_t j = i; j < curves.size(); ++j) {
-      if (curvesCloseInImage(camera, curves[i], curves[j]) ||
-          (i != j && curvesCloseInImage(camera, curves[j], curves[i]))) {
+    for (const FacePoint& p : curves[i].points) {
+      const Vec3 q = camera.project(p.position);
+      projected[i].push_back({q.x, q.y});
+    }
+  }
+  for (size_t i = 0; i < projected.size(); ++i) {
+    for (size_t j = i; j < projected.size(); ++j) {
+      if (curvesCloseInImage(projected[i], projected[j]) ||
+          (i != j && curvesCloseInImage(projected[j], projected[i]))) {
         return true;
       }
     }
