@@ -12,6 +12,8 @@
 #include <iostream>
 #include <utility>
 
+#include "render/raster/warm_up.h"
+
 namespace limn::server {
 
 using Clock = render::CancelToken::Clock;
@@ -278,6 +280,7 @@ void WorkerPool::threadWorkerMain(size_t slot) {
   std::unique_ptr<render::raster::Rasterizer> rasterizer;
   try {
     rasterizer = std::make_unique<render::raster::Rasterizer>();
+    render::raster::warmUp(*rasterizer);
     status.ready = true;
     status.device = rasterizer->device();
   } catch (const std::exception& e) {

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "render/raster/rasterizer.h"
+#include "render/raster/warm_up.h"
 #include "server/tasks.h"
 
 namespace limn::server {
@@ -234,6 +235,7 @@ int workerMain(int fd) {
   wire::Ready ready;
   try {
     rasterizer = std::make_unique<render::raster::Rasterizer>();
+    render::raster::warmUp(*rasterizer);
     ready.ok = true;
     ready.device = rasterizer->device();
   } catch (const std::exception& e) {
