@@ -1,5 +1,5 @@
 // Large arrays on transparent huge pages. The first write to each page of a fresh array faults
-// it in; a 4096^2 float mask (64 MiB) is 16,384 faults of 4 KiB, which on the 2-core development
+// it in; an 8192^2 byte mask (64 MiB) is 16,384 faults of 4 KiB, which on the 2-core development
 // VM cost about 12 us each (190 ms for the array, more than the work done on it), and 32 faults
 // of 2 MiB on huge pages (6 ms). Linux gives huge pages only to ranges advised so when its
 // setting is "madvise" (the usual default), so the arrays of supersampled masks, distance
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "render/core/image.h"
+#include "render/core/mask.h"
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -55,6 +56,15 @@ inline Image imageOnHugePages(int w, int h, int c, float fill = 0.0f) {
   image.channels = c;
   assignOnHugePages(image.pixels, static_cast<size_t>(w) * h * c, fill);
   return image;
+}
+
+// Mask(w, h), all uncovered, on huge pages.
+inline Mask maskOnHugePages(int w, int h) {
+  Mask mask;
+  mask.width = w;
+  mask.height = h;
+  assignOnHugePages(mask.covered, static_cast<size_t>(w) * h, uint8_t{0});
+  return mask;
 }
 
 }  // namespace limn::render

@@ -1,11 +1,14 @@
 // Image and ImageSet: float pixel buffers that raster/ and oracle/ produce and metrics/ and
-// image/ consume. Row 0 is the top row (see camera.h).
+// image/ consume (an ImageSet's supersampled coverage is a byte Mask: mask.h). Row 0 is the top
+// row (see camera.h).
 #pragma once
 
 #include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "render/core/mask.h"
 
 namespace limn::render {
 
@@ -43,7 +46,7 @@ inline constexpr const char* kPatches = "patches";  // RGBA, colour by patch lev
 struct ImageSet {
   std::map<std::string, Image> passes;
   // Coverage at `supersample` times the resolution in each direction, for silhouette metrics.
-  Image supersampledMask;
+  Mask supersampledMask;
   int supersample = 1;
 
   const Image* find(const std::string& name) const {

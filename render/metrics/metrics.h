@@ -56,12 +56,12 @@ struct Metrics {
 Metrics worstOf(const std::vector<Metrics>& views);
 
 // Silhouette pixels of a mask: covered pixels with an uncovered 4-neighbour (outside the image
-// counts as uncovered). Both masks are at `supersample` times the output size, one channel,
-// covered where the value is above 0.5. When only one mask shows anything, hausdorffPx and
-// meanPx are the image diagonal in output pixels; when neither does, both are 0 and iou is 1.
-// Throws std::invalid_argument for masks of different sizes, not one channel, or a size that is
-// not a multiple of `supersample`. `cancel` is checked every band of rows (32768^2 masks take
-// seconds), throwing Cancelled.
+// counts as uncovered). Both masks are at `supersample` times the output size, covered where
+// nonzero. When only one mask shows anything, hausdorffPx and meanPx are the image diagonal in
+// output pixels; when neither does, both are 0 and iou is 1.
+// Throws std::invalid_argument for masks of different sizes, not one byte per pixel, or a size
+// that is not a multiple of `supersample`. `cancel` is checked every band of rows (32768^2 masks
+// take seconds), throwing Cancelled.
 //
 // With `geometry`, a contour pixel of one mask more than a mask pixel from the other's contour
 // and outside the other's geometry is measured to that geometry instead where it is nearer: a
@@ -76,7 +76,7 @@ struct SilhouetteGeometry {
 // within 16 output pixels), or always with the transform (the original way, slower at 4096^2;
 // kept for the tests, which hold both to the same numbers).
 enum class ContourSearch { Nearby, FullTransform };
-SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask, int supersample,
+SilhouetteMetrics compareSilhouettes(const Mask& mask, const Mask& referenceMask, int supersample,
                                      const CancelToken& cancel = CancelToken{},
                                      const SilhouetteGeometry& geometry = {},
                                      ContourSearch search = ContourSearch::Nearby);

@@ -80,15 +80,15 @@ void sortUnique(std::vector<uint64_t>& keys) {
 // Cells (by their first sample) whose four mask samples are not all alike, in sample order.
 // Runs of kRun cells whose two rows hold one value throughout are skipped after a branch-free
 // comparison (most of a mask is uniform), the rest is looked at cell by cell.
-std::vector<uint64_t> mixedCells(const Image& mask, const SampleGrid& grid) {
+std::vector<uint64_t> mixedCells(const Mask& mask, const SampleGrid& grid) {
   constexpr int kRun = 32;
   const int w = grid.width, h = grid.height;
   std::vector<std::vector<uint64_t>> perRow(std::max(0, h - 1));
   tbb::parallel_for(tbb::blocked_range<int>(0, h - 1, 8), [&](const tbb::blocked_range<int>& r) {
     std::vector<uint8_t> top(w), bottom(w);
     auto covered = [&](int j, std::vector<uint8_t>& out) {
-      const float* row = mask.pixels.data() + static_cast<size_t>(j) * w;
-      for (int i = 0; i < w; ++i) out[i] = row[i] > 0.5f;
+      const uint8_t* row = mask.covered.data() + static_cast<size_t>(j) * w;
+      for (int i = 0; i < w; ++i) out[i] = row[i] != 0;
     };
     covered(r.begin(), top);
     for (int j = r.begin(); j < r.end(); ++j) {
@@ -116,10 +116,10 @@ std::vector<uint64_t> mixedCells(const Image& mask, const SampleGrid& grid) {
 
 // The mixed cells in and along the blocks of the flagged output pixels: cells whose first
 // sample lies in [x S - 1, x S + S - 1] x [y S - 1, y S + S - 1] for a flagged (x, y).
-std::vector<uint64_t> mixedCellsIn(const Image& mask, const SampleGrid& grid,
+std::vector<uint64_t> mixedCellsIn(const Mask& mask, const SampleGrid& grid,
                                    const std::vector<char>& scan) {
   const int s = grid.supersample, outWidth = grid.width / s, outHeight = grid.height / s;
-  auto covered = [&](int i, int j) { return mask.at(i, j) > 0.5f; };
+  auto covered = [&](int i, int j) { return mask.at(i, j) != 0; };
   std::vector<uint64_t> cells;
   for (int y = 0; y < outHeight; ++y) {
     for (int x = 0; x < outWidth; ++x) {
@@ -347,12 +347,10 @@ std::vector<std::pair<int, int>> joinCells(const std::vector<uint64_t>& cells,
 
 }  // namespace
 
-Outline locateOutline(const Image& mask, int supersample, const CoverageQuery& query,
+Outline locateOutline(const Mask& mask, int supersample, const CoverageQuery& query,
                       const CancelToken& cancel, const std::vector<char>* scan,
                       double tolerancePx) {
-  if (mask.channels != 1 || supersample < 1) {
-    throw std::invalid_argument("locateOutline: a one-channel mask and a supersample >= 1");
-  }
+  if (supersample < 1) throw std::invalid_argument("locateOutline: a supersample >= 1");
   SampleGrid grid{mask.width, mask.height, supersample};
   const size_t outputPixels =
       static_cast<size_t>(mask.width / supersample) * (mask.height / supersample);

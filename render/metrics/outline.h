@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "render/core/cancel.h"
-#include "render/core/image.h"
+#include "render/core/mask.h"
 #include "render/core/vec.h"
 #include "render/metrics/coverage_distance.h"
 
@@ -43,12 +43,12 @@ struct Outline {
 inline constexpr double kOutlineTolerancePx = 1e-3;
 
 // The outline of a coverage mask at `supersample` times the output size (samples at the centres
-// of its pixels, covered above 0.5), located with `query`. Samples outside the mask are not
+// of its pixels, covered where nonzero), located with `query`. Samples outside the mask are not
 // invented: the outline lies between sample centres, so the image frame is not part of it.
 // `scan` (optional, one flag per output pixel) limits the search to the cells in and along the
 // blocks of the flagged pixels: where the caller knows the mask can be mixed (the reference's
 // refined pixels); otherwise every cell of the mask is looked at.
-Outline locateOutline(const Image& supersampledMask, int supersample, const CoverageQuery& query,
+Outline locateOutline(const Mask& supersampledMask, int supersample, const CoverageQuery& query,
                       const CancelToken& cancel, const std::vector<char>* scan = nullptr,
                       double tolerancePx = kOutlineTolerancePx);
 

@@ -3,7 +3,7 @@
 //
 // Speed matters here (a 1024^2 output at S = 4 is 16.7 million pixels a mask), so the work is
 // arranged as few passes over memory as possible:
-//   1. one pass over both float masks gives a byte per pixel with four flags (covered in A,
+//   1. one pass over both byte masks gives a byte per pixel with four flags (covered in A,
 //      in B, contour of A, of B) and counts IoU and the majority mismatch on the way;
 //   2. per direction, each contour pixel's nearest pixel of the other contour, searched in the
 //      rows around it among the other contour's pixels listed per row (exact, and at 4096^2 a
@@ -54,18 +54,17 @@ struct Classified {
   long mismatchPx = 0;
 };
 
-// Coverage bits (value above one half) of one row of both masks; rows outside the image are
-// uncovered.
-void coverRow(const Image& a, const Image& b, int y, uint8_t* out) {
+// Coverage bits (value nonzero) of one row of both masks; rows outside the image are uncovered.
+void coverRow(const Mask& a, const Mask& b, int y, uint8_t* out) {
   const size_t w = static_cast<size_t>(a.width);
   if (y < 0 || y >= a.height) {
     std::fill(out, out + w, uint8_t{0});
     return;
   }
-  const float* ra = a.pixels.data() + static_cast<size_t>(y) * w;
-  const float* rb = b.pixels.data() + static_cast<size_t>(y) * w;
+  const uint8_t* ra = a.covered.data() + static_cast<size_t>(y) * w;
+  const uint8_t* rb = b.covered.data() + static_cast<size_t>(y) * w;
   for (size_t x = 0; x < w; ++x) {
-    out[x] = static_cast<uint8_t>((ra[x] > 0.5f ? kCoveredA : 0) | (rb[x] > 0.5f ? kCoveredB : 0));
+    out[x] = static_cast<uint8_t>((ra[x] ? kCoveredA : 0) | (rb[x] ? kCoveredB : 0));
   }
 }
 
@@ -81,9 +80,9 @@ void listContourColumns(const uint8_t* row, size_t width, std::vector<int32_t>& 
 // Flags, IoU and majority mismatch in one pass. Contour pixels are covered pixels with an
 // uncovered 4-neighbour; outside the image counts as uncovered, so a shape touching the border
 // has its contour there. Tasks own whole bands of S rows (one output row each) and keep the
-// coverage of three rows in a ring, so each float is read about once and no thread reads
+// coverage of three rows in a ring, so each mask byte is read about once and no thread reads
 // flags another writes.
-Classified classify(const Image& a, const Image& b, int s, const CancelToken& cancel) {
+Classified classify(const Mask& a, const Mask& b, int s, const CancelToken& cancel) {
   const int width = a.width, height = a.height;
   const int outWidth = width / s, outHeight = height / s;
   const size_t w = static_cast<size_t>(width);
@@ -360,7 +359,7 @@ DirectedDistances contourDistances(const Classified& flags, uint8_t fromBit, Laz
   return *d;
 }
 
-void checkMasks(const Image& mask, const Image& referenceMask, int supersample) {
+void checkMasks(const Mask& mask, const Mask& referenceMask, int supersample) {
   if (supersample < 1) {
     throw std::invalid_argument("compareSilhouettes: supersample must be at least 1, got " +
                                 std::to_string(supersample));
@@ -371,10 +370,9 @@ void checkMasks(const Image& mask, const Image& referenceMask, int supersample) 
         std::to_string(mask.height) + " vs " + std::to_string(referenceMask.width) + "x" +
         std::to_string(referenceMask.height));
   }
-  for (const Image* m : {&mask, &referenceMask}) {
-    if (m->channels != 1 ||
-        m->pixels.size() != static_cast<size_t>(m->width) * static_cast<size_t>(m->height)) {
-      throw std::invalid_argument("compareSilhouettes: a mask must have exactly one channel");
+  for (const Mask* m : {&mask, &referenceMask}) {
+    if (m->covered.size() != static_cast<size_t>(m->width) * static_cast<size_t>(m->height)) {
+      throw std::invalid_argument("compareSilhouettes: a mask must hold one byte per pixel");
     }
   }
   if (mask.width % supersample != 0 || mask.height % supersample != 0) {
@@ -387,7 +385,7 @@ void checkMasks(const Image& mask, const Image& referenceMask, int supersample) 
 
 }  // namespace
 
-SilhouetteMetrics compareSilhouettes(const Image& mask, const Image& referenceMask, int supersample,
+SilhouetteMetrics compareSilhouettes(const Mask& mask, const Mask& referenceMask, int supersample,
                                      const CancelToken& cancel, const SilhouetteGeometry& geometry,
                                      ContourSearch search) {
   checkMasks(mask, referenceMask, supersample);

@@ -168,10 +168,10 @@ std::vector<PixelHit> castClosestHits(RTCScene scene, const Camera& camera, RayP
   return hits;
 }
 
-Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
-                   const CancelToken& cancel) {
+Mask castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
+                  const CancelToken& cancel) {
   const int width = camera.width(), height = camera.height();
-  Image mask(width, height, 1, 0.0f);
+  Mask mask(width, height);
   forEachBand(height, cancel, [&](int y0, int y1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -191,7 +191,7 @@ Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
         for (int k = 0; k < 16; ++k) {
           int x, y;
           // An occlusion ray that hit something comes back with tfar = -inf.
-          if (block.pixel(k, x, y) && packet.tfar[k] < 0.0f) mask.at(x, y) = 1.0f;
+          if (block.pixel(k, x, y) && packet.tfar[k] < 0.0f) mask.at(x, y) = 1;
         }
       } else {
         for (int k = 0; k < 16; ++k) {
@@ -200,7 +200,7 @@ Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
           RTCRay ray;
           setRay(ray, pixelRay(camera, x + 0.5, y + 0.5));
           rtcOccluded1(scene, &context, &ray);
-          if (ray.tfar < 0.0f) mask.at(x, y) = 1.0f;
+          if (ray.tfar < 0.0f) mask.at(x, y) = 1;
         }
       }
     }
@@ -263,11 +263,11 @@ void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2
   });
 }
 
-Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
-                          const std::vector<char>& refine, const std::vector<char>& coarse,
-                          const CancelToken& cancel) {
+Mask castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
+                         const std::vector<char>& refine, const std::vector<char>& coarse,
+                         const CancelToken& cancel) {
   const int width = camera.width(), height = camera.height(), s = supersample;
-  Image mask = imageOnHugePages(width * s, height * s, 1, 0.0f);
+  Mask mask = maskOnHugePages(width * s, height * s);
   forEachBand(height, cancel, [&](int y0, int y1) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -279,7 +279,7 @@ Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
         if (!refine[pixel]) {
           if (!coarse[pixel]) continue;
           for (int j = 0; j < s; ++j) {
-            std::fill_n(&mask.at(x * s, y * s + j), s, 1.0f);
+            std::fill_n(&mask.at(x * s, y * s + j), s, uint8_t{1});
           }
           continue;
         }
@@ -292,7 +292,7 @@ Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
           uint32_t hits = occludedLanes(scene, camera, &samples[first], count, context);
           for (int k = 0; k < count; ++k) {
             int i = (first + k) % s, j = (first + k) / s;
-            if ((hits >> k) & 1) mask.at(x * s + i, y * s + j) = 1.0f;
+            if ((hits >> k) & 1) mask.at(x * s + i, y * s + j) = 1;
           }
         }
       }

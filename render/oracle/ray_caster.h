@@ -14,7 +14,7 @@
 
 #include "render/core/camera.h"
 #include "render/core/cancel.h"
-#include "render/core/image.h"
+#include "render/core/mask.h"
 
 namespace limn::render::oracle {
 
@@ -50,8 +50,8 @@ void castClosestHitsAt(RTCScene scene, const Camera& camera, const std::vector<V
 
 // Coverage of all pixels of `camera`: 1 where the ray hits anything, else 0 (occlusion rays,
 // cheaper than closest hits).
-Image castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
-                   const CancelToken& cancel);
+Mask castCoverage(RTCScene scene, const Camera& camera, RayPacking packing,
+                  const CancelToken& cancel);
 
 // Coverage at arbitrary image-plane points of `camera` (output pixels, x right, y down): 1 where
 // the ray through the point hits anything. covered is resized to points.size(). All threads;
@@ -63,8 +63,8 @@ void castCoverageAt(RTCScene scene, const Camera& camera, const std::vector<Vec2
 // change it: output pixels marked in `refine` (row-major, width * height) get all S x S of their
 // samples cast; the others copy `coarse`'s value (1 covered / 0 not, per output pixel) into
 // their whole block.
-Image castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
-                          const std::vector<char>& refine, const std::vector<char>& coarse,
-                          const CancelToken& cancel);
+Mask castCoverageRefined(RTCScene scene, const Camera& camera, int supersample,
+                         const std::vector<char>& refine, const std::vector<char>& coarse,
+                         const CancelToken& cancel);
 
 }  // namespace limn::render::oracle

@@ -243,7 +243,7 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 }
 
 metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,
-                                   const Image& supersampledMask, int supersample,
+                                   const Mask& supersampledMask, int supersample,
                                    const CancelToken& cancel, const std::vector<char>* scan) {
   // With `scan`, every point queried lies within a pixel of a flagged one, and a ray there can
   // only hit a triangle whose screen box reaches that far: the scene needs those triangles

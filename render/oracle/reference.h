@@ -66,8 +66,8 @@ struct ReferenceResult {
 // one of them, so one reference hinted with the merged blocks is as exact, wherever any of
 // those masks has an outline, as a reference hinted with each mask alone.
 inline constexpr uint8_t kBlockUncovered = 1, kBlockCovered = 2;
-// `supersampledMask` is at `s` times the output size (one channel, covered above 0.5).
-std::vector<uint8_t> maskBlocks(const Image& supersampledMask, int s);
+// `supersampledMask` is at `s` times the output size.
+std::vector<uint8_t> maskBlocks(const Mask& supersampledMask, int s);
 // into |= blocks (into may start empty); blocks of different sizes throw std::invalid_argument.
 void mergeMaskBlocks(std::vector<uint8_t>& into, const std::vector<uint8_t>& blocks);
 
@@ -75,7 +75,7 @@ struct ReferenceOptions {
   // A mask at S times the output size (the approximation's): output pixels where its S x S
   // block is not uniform, or disagrees with the reference's own pixel, get all their samples
   // cast too, so the reference's mask is exact wherever either side has an outline.
-  const Image* maskHint = nullptr;
+  const Mask* maskHint = nullptr;
   // The same hint as blocks (maskBlocks, merged over several masks); taken over maskHint.
   const std::vector<uint8_t>* hintBlocks = nullptr;
   bool locateOutline = false;            // needs passes.supersample > 0
@@ -114,7 +114,7 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 // `scan`: the reference's refinedPixels when that reference was hinted with this mask (then they
 // hold every place this mask can be mixed), or null to look everywhere.
 metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,
-                                   const Image& supersampledMask, int supersample,
+                                   const Mask& supersampledMask, int supersample,
                                    const CancelToken& cancel,
                                    const std::vector<char>* scan = nullptr);
 
@@ -137,9 +137,8 @@ metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const C
 // With `outline`, also locates the outline of Embree's surface to sub-pixel precision (rays on
 // its own scene): `camera` must then be an output camera scaled by `supersample`, and the
 // outline is in that output camera's pixels.
-std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
-                                           const Camera& camera, const CancelToken& cancel,
-                                           std::string* whyNot, int supersample = 1,
-                                           metrics::Outline* outline = nullptr);
+std::optional<Mask> embreeSubdivisionMask(const subdiv::LimitSurface& surface, const Camera& camera,
+                                          const CancelToken& cancel, std::string* whyNot,
+                                          int supersample = 1, metrics::Outline* outline = nullptr);
 
 }  // namespace limn::render::oracle

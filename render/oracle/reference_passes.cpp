@@ -14,19 +14,19 @@
 
 namespace limn::render::oracle {
 
-std::vector<uint8_t> maskBlocks(const Image& supersampledMask, int s) {
+std::vector<uint8_t> maskBlocks(const Mask& supersampledMask, int s) {
   const int width = supersampledMask.width / s, height = supersampledMask.height / s;
   std::vector<uint8_t> blocks(static_cast<size_t>(width) * height, 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y) {
       uint8_t* out = &blocks[static_cast<size_t>(y) * width];
       for (int j = y * s; j < (y + 1) * s; ++j) {
-        const float* row =
-            &supersampledMask.pixels[static_cast<size_t>(j) * supersampledMask.width];
+        const uint8_t* row =
+            supersampledMask.covered.data() + static_cast<size_t>(j) * supersampledMask.width;
         for (int x = 0; x < width; ++x) {
           uint8_t seen = 0;
           for (int i = x * s; i < (x + 1) * s; ++i)
-            seen |= row[i] > 0.5f ? kBlockCovered : kBlockUncovered;
+            seen |= row[i] ? kBlockCovered : kBlockUncovered;
           out[x] |= seen;
         }
       }
@@ -68,8 +68,8 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<c
 }
 
 std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
-                                 int width, int height, const Image* hint, int s) {
-  if (!hint || hint->width != width * s || hint->height != height * s || hint->channels != 1) {
+                                 int width, int height, const Mask* hint, int s) {
+  if (!hint || hint->width != width * s || hint->height != height * s) {
     return pixelsToRefine(covered, std::move(refine), width, height, nullptr);
   }
   const std::vector<uint8_t> blocks = maskBlocks(*hint, s);

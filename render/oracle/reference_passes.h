@@ -123,7 +123,7 @@ std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<c
                                  int width, int height, const std::vector<uint8_t>* hint);
 // The same with the hint a mask at `s` times the size (ignored when it is not).
 std::vector<char> pixelsToRefine(const std::vector<char>& covered, std::vector<char> refine,
-                                 int width, int height, const Image* hint, int s);
+                                 int width, int height, const Mask* hint, int s);
 
 // The supersampled mask of `scene` at S = s, S x S rays only in the pixels that need them
 // (result.refinedPixels): `candidates` (outline candidates known beforehand; may be empty),

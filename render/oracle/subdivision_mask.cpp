@@ -185,7 +185,7 @@ float uniformLevel(const subdiv::LimitSurface& surface, const Camera& camera) {
 // points kCrackProbesPx around its centre, along the axes and the diagonals: a crack is a line,
 // which passes through at most two opposite probes, so six or more hits make it a crack and the
 // pixel covered; a hole in the surface has area and gets none.
-void closeCracks(RTCScene scene, const Camera& camera, Image& mask, const CancelToken& cancel) {
+void closeCracks(RTCScene scene, const Camera& camera, Mask& mask, const CancelToken& cancel) {
   constexpr int kProbes = 8, kHitsForACrack = 6;
   constexpr int kDirections[kProbes][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1},
                                            {-1, 0},  {1, 0},  {0, -1}, {0, 1}};
@@ -193,8 +193,8 @@ void closeCracks(RTCScene scene, const Camera& camera, Image& mask, const Cancel
   std::vector<std::pair<int, int>> suspects;
   for (int y = 1; y + 1 < h; ++y) {
     for (int x = 1; x + 1 < w; ++x) {
-      if (mask.at(x, y) == 0 && mask.at(x - 1, y) > 0 && mask.at(x + 1, y) > 0 &&
-          mask.at(x, y - 1) > 0 && mask.at(x, y + 1) > 0) {
+      if (!mask.at(x, y) && mask.at(x - 1, y) && mask.at(x + 1, y) && mask.at(x, y - 1) &&
+          mask.at(x, y + 1)) {
         suspects.emplace_back(x, y);
       }
     }
@@ -213,7 +213,7 @@ void closeCracks(RTCScene scene, const Camera& camera, Image& mask, const Cancel
       int hits = 0;
       for (int i = 0; i < kProbes; ++i) hits += covered[k * kProbes + i];
       if (hits >= kHitsForACrack) {
-        mask.at(suspects[k].first, suspects[k].second) = 1.0f;
+        mask.at(suspects[k].first, suspects[k].second) = 1;
       } else {
         stillOpen.push_back(suspects[k]);
       }
@@ -229,11 +229,10 @@ T* newBuffer(RTCGeometry g, RTCBufferType type, RTCFormat format, size_t count) 
 
 }  // namespace
 
-std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
-                                           const Camera& camera, const CancelToken& cancel,
-                                           std::string* whyNot, int supersample,
-                                           metrics::Outline* outline) {
-  auto refuse = [&](std::string reason) -> std::optional<Image> {
+std::optional<Mask> embreeSubdivisionMask(const subdiv::LimitSurface& surface, const Camera& camera,
+                                          const CancelToken& cancel, std::string* whyNot,
+                                          int supersample, metrics::Outline* outline) {
+  auto refuse = [&](std::string reason) -> std::optional<Mask> {
     if (whyNot) *whyNot = std::move(reason);
     return std::nullopt;
   };
@@ -313,7 +312,7 @@ std::optional<Image> embreeSubdivisionMask(const subdiv::LimitSurface& surface,
     return refuse("Embree rejected the subdivision mesh: " + error);
   }
   cancel.check();
-  Image mask = castCoverage(scene.get(), camera, RayPacking::Packet16, cancel);
+  Mask mask = castCoverage(scene.get(), camera, RayPacking::Packet16, cancel);
   closeCracks(scene.get(), camera, mask, cancel);
   if (outline) {
     // The outline's points are in output pixels; the rays go through the same points of the

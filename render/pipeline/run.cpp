@@ -37,7 +37,7 @@ void crossCheckReference(const subdiv::LimitSurface& surface, const Camera& came
                          RenderResult& result) {
   std::string whyNot;
   metrics::Outline embreeOutline;
-  std::optional<Image> embreeMask =
+  std::optional<Mask> embreeMask =
       oracle::embreeSubdivisionMask(surface, camera.scaled(S), cancel, &whyNot, S, &embreeOutline);
   if (!embreeMask) {
     result.warnings.push_back("reference cross-check skipped: " + whyNot);

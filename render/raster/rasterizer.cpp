@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -74,15 +75,16 @@ int largestFramebufferSide() {
 }
 
 // Copies a tile read back from OpenGL (bottom row first, `srcComponents` values per pixel)
-// into its place in `dst` (top row first), through `convert(const T* src, float* dst)`.
-template <typename T, typename Convert>
-void placeTile(const std::vector<T>& src, int srcComponents, const Tile& tile, Image& dst,
+// into its place in `dst` (an Image or a Mask, top row first), through
+// `convert(const T* src, pixel* dst)`.
+template <typename T, typename Destination, typename Convert>
+void placeTile(const std::vector<T>& src, int srcComponents, const Tile& tile, Destination& dst,
                Convert convert) {
   for (int r = 0; r < tile.height; ++r) {
     const int dstRow = tile.y + tile.height - 1 - r;
     for (int i = 0; i < tile.width; ++i) {
       const T* from = &src[(static_cast<size_t>(r) * tile.width + i) * srcComponents];
-      convert(from, &dst.at(tile.x + i, dstRow, 0));
+      convert(from, &dst.at(tile.x + i, dstRow));
     }
   }
 }
@@ -411,7 +413,9 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample,
                                       const CancelToken& cancel, ImageSet& out) {
   const Camera big = camera.scaled(supersample);
   const int width = big.width(), height = big.height();
-  Image covered = imageOnHugePages(width, height, 1);  // 64 MiB at 4096^2: huge_pages.h
+  // 64 MiB at 8192^2, on huge pages (huge_pages.h): its zero fill, which the tiles then
+  // overwrite, takes ~10 ms.
+  Mask covered = maskOnHugePages(width, height);
   const Mat4 viewProjection = multiply(big.projectionMatrix(), big.viewMatrix());
   const float one[4] = {1, 1, 1, 1};
   const float zero[4] = {0, 0, 0, 0};
@@ -430,7 +434,7 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample,
     checkGl("drawing the supersampled coverage");
     coverage.readRedBytes(0, readbackBytes);
     placeTile(readbackBytes, 1, tile, covered,
-              [](const unsigned char* from, float* to) { *to = *from > 127 ? 1.0f : 0.0f; });
+              [](const unsigned char* from, uint8_t* to) { *to = *from > 127 ? 1 : 0; });
   }
   out.supersampledMask = std::move(covered);
   out.supersample = supersample;

@@ -28,32 +28,32 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // Helpers
 
-Image disc(int size, double cx, double cy, double radius) {
-  Image mask(size, size, 1);
+Mask disc(int size, double cx, double cy, double radius) {
+  Mask mask(size, size);
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
       const double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
-      mask.at(x, y) = dx * dx + dy * dy <= radius * radius ? 1.0f : 0.0f;
+      mask.at(x, y) = dx * dx + dy * dy <= radius * radius;
     }
   }
   return mask;
 }
 
-Image rectangle(int width, int height, int x0, int y0, int x1, int y1) {
-  Image mask(width, height, 1);
+Mask rectangle(int width, int height, int x0, int y0, int x1, int y1) {
+  Mask mask(width, height);
   for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) mask.at(x, y) = 1.0f;
+    for (int x = x0; x < x1; ++x) mask.at(x, y) = 1;
   }
   return mask;
 }
 
-bool coveredAt(const Image& m, int x, int y) {
-  return x >= 0 && y >= 0 && x < m.width && y < m.height && m.at(x, y) > 0.5f;
+bool coveredAt(const Mask& m, int x, int y) {
+  return x >= 0 && y >= 0 && x < m.width && y < m.height && m.at(x, y) != 0;
 }
 
 // The definition, written out the slow way: covered with an uncovered 4-neighbour or on the
 // border.
-std::vector<std::pair<int, int>> bruteSilhouette(const Image& m) {
+std::vector<std::pair<int, int>> bruteSilhouette(const Mask& m) {
   std::vector<std::pair<int, int>> out;
   for (int y = 0; y < m.height; ++y) {
     for (int x = 0; x < m.width; ++x) {
@@ -135,7 +135,7 @@ TEST(DistanceTransform, RejectsBufferOfWrongSize) {
 // Silhouettes
 
 TEST(Silhouette, IdenticalMasksAgreeExactly) {
-  const Image a = disc(200, 100, 100, 60);
+  const Mask a = disc(200, 100, 100, 60);
   const SilhouetteMetrics m = compareSilhouettes(a, a, 1);
   EXPECT_EQ(m.hausdorffPx, 0.0);
   EXPECT_EQ(m.meanPx, 0.0);
@@ -144,8 +144,8 @@ TEST(Silhouette, IdenticalMasksAgreeExactly) {
 }
 
 TEST(Silhouette, ConcentricDiscsAreTheirRadiusDifferenceApart) {
-  const Image a = disc(256, 128, 128, 100);
-  const Image b = disc(256, 128, 128, 103);
+  const Mask a = disc(256, 128, 128, 100);
+  const Mask b = disc(256, 128, 128, 103);
   const SilhouetteMetrics m = compareSilhouettes(a, b, 1);
   EXPECT_NEAR(m.hausdorffPx, 3.0, 1.0);
   EXPECT_NEAR(m.meanPx, 3.0, 1.0);
@@ -162,8 +162,8 @@ TEST(Silhouette, ConcentricDiscsAreTheirRadiusDifferenceApart) {
 
 TEST(Silhouette, ShiftedSquareIsShiftApartInOutputPixels) {
   for (int k : {1, 3, 7}) {
-    const Image a = rectangle(160, 120, 40, 30, 100, 90);
-    const Image b = rectangle(160, 120, 40 + k, 30, 100 + k, 90);
+    const Mask a = rectangle(160, 120, 40, 30, 100, 90);
+    const Mask b = rectangle(160, 120, 40 + k, 30, 100 + k, 90);
     const SilhouetteMetrics m = compareSilhouettes(a, b, 1);
     EXPECT_DOUBLE_EQ(m.hausdorffPx, k) << "shift " << k;
     EXPECT_GT(m.meanPx, 0.0);
@@ -175,8 +175,8 @@ TEST(Silhouette, ShiftedSquareIsShiftApartInOutputPixels) {
 
 TEST(Silhouette, SupersampleDividesDistancesIntoOutputPixels) {
   const int s = 4, k = 6;  // a shift of 6 supersampled pixels is 1.5 output pixels
-  const Image a = rectangle(64 * s, 48 * s, 10 * s, 10 * s, 40 * s, 30 * s);
-  const Image b = rectangle(64 * s, 48 * s, 10 * s + k, 10 * s, 40 * s + k, 30 * s);
+  const Mask a = rectangle(64 * s, 48 * s, 10 * s, 10 * s, 40 * s, 30 * s);
+  const Mask b = rectangle(64 * s, 48 * s, 10 * s + k, 10 * s, 40 * s + k, 30 * s);
   const SilhouetteMetrics m = compareSilhouettes(a, b, s);
   EXPECT_DOUBLE_EQ(m.hausdorffPx, 1.5);
   // a covers output columns 10..39. b starts 6 pixels later: column 10 is empty in b, column 11
@@ -190,13 +190,13 @@ TEST(Silhouette, MatchesBruteForceOnRandomShapes) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int trial = 0; trial < 20; ++trial) {
     const int w = 24 + trial * 3, h = 40 - trial;
-    Image a(w, h, 1), b(w, h, 1);
-    for (Image* m : {&a, &b}) {
+    Mask a(w, h), b(w, h);
+    for (Mask* m : {&a, &b}) {
       for (int blob = 0; blob < 3; ++blob) {
         const double cx = unit(rng) * w, cy = unit(rng) * h, r = 2 + unit(rng) * 8;
         for (int y = 0; y < h; ++y) {
           for (int x = 0; x < w; ++x) {
-            if (std::hypot(x + 0.5 - cx, y + 0.5 - cy) <= r) m->at(x, y) = 0.9f;
+            if (std::hypot(x + 0.5 - cx, y + 0.5 - cy) <= r) m->at(x, y) = 1;
           }
         }
       }
@@ -216,8 +216,8 @@ TEST(Silhouette, ImageBorderCountsAsUncovered) {
   // A mask covering everything has its contour on the border; one that leaves a one-pixel
   // frame has its contour one pixel inside. Every contour pixel of either is 1 pixel from the
   // other contour, except the 4 image corners, sqrt(2) from the inset's corners.
-  const Image full(50, 40, 1, 1.0f);
-  const Image inset = rectangle(50, 40, 1, 1, 49, 39);
+  const Mask full = rectangle(50, 40, 0, 0, 50, 40);
+  const Mask inset = rectangle(50, 40, 1, 1, 49, 39);
   EXPECT_EQ(compareSilhouettes(full, full, 1).hausdorffPx, 0.0);
   const SilhouetteMetrics m = compareSilhouettes(full, inset, 1);
   EXPECT_DOUBLE_EQ(m.hausdorffPx, std::sqrt(2.0));
@@ -230,9 +230,9 @@ TEST(Silhouette, IouAndMismatchOnHandMadeMasks) {
   // 4x2 output pixels at S = 2 (8x4 mask). Block coverage counts in a / b:
   //   block (0,0): 4 / 4   block (1,0): 3 / 2   block (2,0): 2 / 3   block (3,0): 0 / 1
   //   block (0,1): 1 / 0   others 0 / 0
-  Image a(8, 4, 1), b(8, 4, 1);
-  auto set = [](Image& m, std::initializer_list<std::pair<int, int>> pixels) {
-    for (auto [x, y] : pixels) m.at(x, y) = 1.0f;
+  Mask a(8, 4), b(8, 4);
+  auto set = [](Mask& m, std::initializer_list<std::pair<int, int>> pixels) {
+    for (auto [x, y] : pixels) m.at(x, y) = 1;
   };
   set(a, {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, {3, 0}, {2, 1}, {4, 0}, {5, 0}, {0, 2}});
   set(b, {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, {3, 1}, {4, 0}, {5, 0}, {4, 1}, {7, 1}});
@@ -244,7 +244,7 @@ TEST(Silhouette, IouAndMismatchOnHandMadeMasks) {
 }
 
 TEST(Silhouette, EmptyMasks) {
-  const Image empty(40, 30, 1);
+  const Mask empty(40, 30);
   const SilhouetteMetrics both = compareSilhouettes(empty, empty, 2);
   EXPECT_EQ(both.hausdorffPx, 0.0);
   EXPECT_EQ(both.meanPx, 0.0);
@@ -252,7 +252,7 @@ TEST(Silhouette, EmptyMasks) {
   EXPECT_EQ(both.mismatchPx, 0);
 
   // Object in one image only: the distance is the image diagonal in output pixels (20 x 15).
-  const Image some = rectangle(40, 30, 10, 10, 20, 20);
+  const Mask some = rectangle(40, 30, 10, 10, 20, 20);
   const SilhouetteMetrics one = compareSilhouettes(some, empty, 2);
   EXPECT_DOUBLE_EQ(one.hausdorffPx, 25.0);
   EXPECT_EQ(one.iou, 0.0);
@@ -261,18 +261,20 @@ TEST(Silhouette, EmptyMasks) {
 }
 
 TEST(Silhouette, RejectsMismatchedMasks) {
-  EXPECT_THROW(compareSilhouettes(Image(8, 8, 1), Image(8, 4, 1), 1), std::invalid_argument);
-  EXPECT_THROW(compareSilhouettes(Image(8, 8, 1), Image(8, 8, 1), 3), std::invalid_argument);
-  EXPECT_THROW(compareSilhouettes(Image(8, 8, 1), Image(8, 8, 1), 0), std::invalid_argument);
-  EXPECT_THROW(compareSilhouettes(Image(8, 8, 4), Image(8, 8, 4), 1), std::invalid_argument);
+  EXPECT_THROW(compareSilhouettes(Mask(8, 8), Mask(8, 4), 1), std::invalid_argument);
+  EXPECT_THROW(compareSilhouettes(Mask(8, 8), Mask(8, 8), 3), std::invalid_argument);
+  EXPECT_THROW(compareSilhouettes(Mask(8, 8), Mask(8, 8), 0), std::invalid_argument);
+  Mask short8(8, 8);  // a byte short of its size
+  short8.covered.pop_back();
+  EXPECT_THROW(compareSilhouettes(short8, short8, 1), std::invalid_argument);
 }
 
 // Not a timed test (that would fail on a slow day): it checks the answer at the largest size
 // the service uses by default (1024^2 output at S = 4) and prints how long it took.
 TEST(Silhouette, LargeSupersampledMasks) {
   const int s = 4, size = 1024 * s;
-  const Image a = disc(size, size / 2.0, size / 2.0, 1500.0);
-  const Image b = disc(size, size / 2.0 + 0.3, size / 2.0, 1504.0);
+  const Mask a = disc(size, size / 2.0, size / 2.0, 1500.0);
+  const Mask b = disc(size, size / 2.0 + 0.3, size / 2.0, 1504.0);
   const auto start = std::chrono::steady_clock::now();
   const SilhouetteMetrics m = compareSilhouettes(a, b, s);
   const double ms =
@@ -631,8 +633,8 @@ TEST(Geometry, MeshWithoutLimitInformationIsRejected) {
 
 using Shape = std::function<bool(double x, double y)>;
 
-Image sampleMask(const Shape& inside, int size, int s) {
-  Image mask(size * s, size * s, 1);
+Mask sampleMask(const Shape& inside, int size, int s) {
+  Mask mask(size * s, size * s);
   for (int j = 0; j < size * s; ++j) {
     for (int i = 0; i < size * s; ++i) mask.at(i, j) = inside((i + 0.5) / s, (j + 0.5) / s);
   }
@@ -806,20 +808,20 @@ TEST(CoverageDistance, NeedleNarrowerThanTheSamplesIsNotAGapInTheSilhouette) {
   auto maskOf = [&](double y0, double y1) {
     auto triangles = square;
     triangles.push_back({Vec2{10, y0}, Vec2{10, y1}, Vec2{15, 0.5 * (y0 + y1)}});
-    Image mask(kSize * kS, kSize * kS, 1);
+    Mask mask(kSize * kS, kSize * kS);
     for (int j = 0; j < kSize * kS; ++j) {
       for (int i = 0; i < kSize * kS; ++i) {
         const Vec2 p{(i + 0.5) / kS, (j + 0.5) / kS};
         for (const auto& t : triangles) {
-          if (pointTriangleDistance(p, t[0], t[1], t[2]) == 0) mask.at(i, j) = 1.0f;
+          if (pointTriangleDistance(p, t[0], t[1], t[2]) == 0) mask.at(i, j) = 1;
         }
       }
     }
     return mask;
   };
-  const Image maskA = maskOf(6.95, 7.3), maskB = maskOf(7.01, 7.09);
-  ASSERT_GT(maskA.at(13 * kS, 7 * kS), 0.5f);  // A's needle has samples
-  ASSERT_LT(maskB.at(13 * kS, 7 * kS), 0.5f);  // B's has none
+  const Mask maskA = maskOf(6.95, 7.3), maskB = maskOf(7.01, 7.09);
+  ASSERT_TRUE(maskA.at(13 * kS, 7 * kS));   // A's needle has samples
+  ASSERT_FALSE(maskB.at(13 * kS, 7 * kS));  // B's has none
   const SilhouetteMetrics sampled = compareSilhouettes(maskA, maskB, kS);
   EXPECT_GT(sampled.hausdorffPx, 2.0);  // the samples see a missing needle
   const CoverageDistanceQuery geometryA = meshCoverageDistance(meshA, camera, kNever);
@@ -849,7 +851,7 @@ TEST(Silhouette, NearbySearchGivesTheTransformsNumbersExactly) {
   const Camera camera = pixelCamera(kSize, kSize);
   for (int trial = 0; trial < 24; ++trial) {
     const double shift = (trial % 6) * 18.0 / kS;  // output pixels
-    Image a(kSize * kS, kSize * kS, 1), b(kSize * kS, kSize * kS, 1);
+    Mask a(kSize * kS, kSize * kS), b(kSize * kS, kSize * kS);
     std::vector<std::array<Vec2, 3>> trianglesA, trianglesB;
     for (int blob = 0; blob < 3; ++blob) {
       const double cx = 20 + unit(rng) * 50, cy = 20 + unit(rng) * 50, r = 3 + unit(rng) * 15;
@@ -857,8 +859,8 @@ TEST(Silhouette, NearbySearchGivesTheTransformsNumbersExactly) {
       for (int j = 0; j < kSize * kS; ++j) {
         for (int i = 0; i < kSize * kS; ++i) {
           const double x = (i + 0.5) / kS, y = (j + 0.5) / kS;
-          if (std::hypot(x - cx, y - cy) <= r) a.at(i, j) = 1.0f;
-          if (std::hypot(x - cx - shift, y - cy + 0.3 * shift) <= rb) b.at(i, j) = 1.0f;
+          if (std::hypot(x - cx, y - cy) <= r) a.at(i, j) = 1;
+          if (std::hypot(x - cx - shift, y - cy + 0.3 * shift) <= rb) b.at(i, j) = 1;
         }
       }
       trianglesA.push_back({Vec2{cx - r, cy - r}, Vec2{cx + r, cy - r}, Vec2{cx, cy + r}});

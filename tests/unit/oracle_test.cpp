@@ -59,22 +59,28 @@ double coverage(const Image& mask) {
   return sum;
 }
 
+double coverage(const Mask& mask) {
+  double sum = 0;
+  for (uint8_t v : mask.covered) sum += v;
+  return sum;
+}
+
 // Outline length of a mask in its own pixels (4-neighbour transitions), for turning an area
 // difference into a mean displacement of the outline.
-double outlineLength(const Image& mask) {
+double outlineLength(const Mask& mask) {
   double edges = 0;
   for (int y = 0; y < mask.height; ++y) {
     for (int x = 0; x < mask.width; ++x) {
-      bool c = mask.at(x, y) > 0.5f;
-      if (x + 1 < mask.width && c != (mask.at(x + 1, y) > 0.5f)) ++edges;
-      if (y + 1 < mask.height && c != (mask.at(x, y + 1) > 0.5f)) ++edges;
+      bool c = mask.at(x, y);
+      if (x + 1 < mask.width && c != bool(mask.at(x + 1, y))) ++edges;
+      if (y + 1 < mask.height && c != bool(mask.at(x, y + 1))) ++edges;
     }
   }
   return edges * std::numbers::pi / 4;  // staircase length -> curve length, on average
 }
 
 // Mean displacement between two masks' outlines in output pixels: area difference / length.
-double meanOutlineShiftPx(const Image& a, int sa, const Image& b, int sb) {
+double meanOutlineShiftPx(const Mask& a, int sa, const Mask& b, int sb) {
   double areaA = coverage(a) / (sa * sa), areaB = coverage(b) / (sb * sb);
   double lengthA = outlineLength(a) / sa;
   return std::fabs(areaA - areaB) / std::max(lengthA, 1.0);
@@ -250,10 +256,10 @@ TEST(Reference, CubeOutlineMatchesLimitSilhouette) {
 
   // At S = 8 the row S * row + S / 2 is half a supersampled pixel off y = 0, where the outline
   // is vertical to far better than that; its pixel centres sit at offsets k + 1/2.
-  const Image& fine = r.images.supersampledMask;
+  const Mask& fine = r.images.supersampledMask;
   ASSERT_EQ(fine.width, size * S);
   int fineCovered = 0;
-  for (int x = 0; x < fine.width; ++x) fineCovered += fine.at(x, S * row + S / 2) > 0.5f;
+  for (int x = 0; x < fine.width; ++x) fineCovered += fine.at(x, S * row + S / 2);
   double fineHalf = halfWidth * S + 0.5;
   expectRow(fineCovered, 2 * std::floor(fineHalf), fineHalf - std::floor(fineHalf), "S = 8");
 }
@@ -263,21 +269,24 @@ TEST(Reference, CubeMaskIsSymmetric) {
   const int size = 201, S = 4;
   Camera camera = viewOf(surface, size);
   ReferenceResult r = renderReference(surface, camera, allPasses(S), CancelToken());
-  for (const Image* mask : {&r.images.passes.at(pass::kMask), &r.images.supersampledMask}) {
+  // The output pass (float Image) and the supersampled mask (byte Mask), both 1 / 0.
+  auto expectSymmetric = [](const auto& mask) {
     int asymmetric = 0, covered = 0;
-    for (int y = 0; y < mask->height; ++y) {
-      for (int x = 0; x < mask->width; ++x) {
-        bool c = mask->at(x, y) > 0.5f;
+    for (int y = 0; y < mask.height; ++y) {
+      for (int x = 0; x < mask.width; ++x) {
+        bool c = mask.at(x, y) > 0.5f;
         covered += c;
-        asymmetric += c != (mask->at(mask->width - 1 - x, y) > 0.5f);
-        asymmetric += c != (mask->at(x, mask->height - 1 - y) > 0.5f);
-        asymmetric += c != (mask->at(y, x) > 0.5f);  // the cube seen from +Z is square
+        asymmetric += c != (mask.at(mask.width - 1 - x, y) > 0.5f);
+        asymmetric += c != (mask.at(x, mask.height - 1 - y) > 0.5f);
+        asymmetric += c != (mask.at(y, x) > 0.5f);  // the cube seen from +Z is square
       }
     }
-    EXPECT_GT(covered, mask->width * mask->height / 10);
+    EXPECT_GT(covered, mask.width * mask.height / 10);
     // Only pixel centres within float rounding of the outline may differ.
-    EXPECT_LE(asymmetric, mask->width / 50) << mask->width;
-  }
+    EXPECT_LE(asymmetric, mask.width / 50) << mask.width;
+  };
+  expectSymmetric(r.images.passes.at(pass::kMask));
+  expectSymmetric(r.images.supersampledMask);
 }
 
 TEST(Reference, SupersampleFactorsAgree) {
@@ -293,7 +302,7 @@ TEST(Reference, SupersampleFactorsAgree) {
   EXPECT_LT(meanOutlineShiftPx(r4.images.supersampledMask, 4, r8.images.supersampledMask, 8), 0.02);
   // Upsample S = 4 to S = 8 (each pixel to 2 x 2): the outlines are within the quantisation of
   // the coarser mask (a quarter pixel) plus the half-pixel offset of sample positions.
-  Image up(160 * 8, 160 * 8, 1);
+  Mask up(160 * 8, 160 * 8);
   for (int y = 0; y < up.height; ++y) {
     for (int x = 0; x < up.width; ++x) up.at(x, y) = r4.images.supersampledMask.at(x / 2, y / 2);
   }
@@ -342,11 +351,11 @@ TEST(Reference, MaskCastWhereItCanChangeEqualsEveryRayCast) {
     const int S = 4;
     ReferenceResult r = renderReference(surface, camera, PassSelection{.supersample = S}, {});
     std::shared_ptr<const ReferenceScene> scene = buildReferenceScene(surface, camera, {});
-    Image full = castCoverage(scene->scene.get(), camera.scaled(S), RayPacking::Packet16, {});
-    ASSERT_EQ(full.pixels.size(), r.images.supersampledMask.pixels.size());
+    Mask full = castCoverage(scene->scene.get(), camera.scaled(S), RayPacking::Packet16, {});
+    ASSERT_EQ(full.covered.size(), r.images.supersampledMask.covered.size());
     size_t differ = 0;
-    for (size_t k = 0; k < full.pixels.size(); ++k) {
-      differ += full.pixels[k] != r.images.supersampledMask.pixels[k];
+    for (size_t k = 0; k < full.covered.size(); ++k) {
+      differ += full.covered[k] != r.images.supersampledMask.covered[k];
     }
     EXPECT_EQ(differ, 0u) << v.name;
     // Only a band around the outline was cast at S x S.
@@ -361,7 +370,7 @@ TEST(Reference, HintMakesTheMaskExactWhereTheHintHasAnOutline) {
   subdiv::LimitSurface surface(testing::cube());
   Camera camera = viewOf(surface, 64);
   const int S = 4;
-  Image hint(64 * S, 64 * S, 1);
+  Mask hint(64 * S, 64 * S);
   for (int j = 0; j < hint.height; ++j) {
     for (int i = 0; i < hint.width; ++i) hint.at(i, j) = std::hypot(i - 20.0, j - 20.0) < 12;
   }
@@ -369,7 +378,7 @@ TEST(Reference, HintMakesTheMaskExactWhereTheHintHasAnOutline) {
   ReferenceResult hinted =
       renderReference(surface, camera, PassSelection{.supersample = S}, {}, {.maskHint = &hint});
   EXPECT_GT(hinted.stats.refinedPixels, plain.stats.refinedPixels);
-  EXPECT_EQ(hinted.images.supersampledMask.pixels, plain.images.supersampledMask.pixels);
+  EXPECT_EQ(hinted.images.supersampledMask.covered, plain.images.supersampledMask.covered);
 }
 
 // The reference's continuous outline located from masks at S = 4 and S = 8 agrees within
@@ -423,7 +432,7 @@ TEST(Reference, RefinedPixelsHoldTheHintedApproximationsWholeOutline) {
     const int S = 4;
     tessellate::TriangleMesh cage = tessellate::tessellateCoarse(surface);
     EmbreeScene cageScene = buildTriangleScene(cage, RTC_BUILD_QUALITY_LOW);
-    Image cageMask = castCoverage(cageScene.get(), camera.scaled(S), RayPacking::Packet16, {});
+    Mask cageMask = castCoverage(cageScene.get(), camera.scaled(S), RayPacking::Packet16, {});
     ReferenceResult r = renderReference(surface, camera, PassSelection{.supersample = S}, {},
                                         {.maskHint = &cageMask});
     metrics::Outline everywhere = locateMeshOutline(cage, camera, cageMask, S, {});
@@ -451,7 +460,7 @@ TEST(Reference, ApproximationOutlineFromTheNearbyTrianglesAgreesWithTheWholeMesh
     const tessellate::TriangleMesh approx =
         tessellate::tessellateAdaptive(surface, camera, options, {});
     EmbreeScene whole = buildTriangleScene(approx, RTC_BUILD_QUALITY_LOW);
-    const Image mask = castCoverage(whole.get(), camera.scaled(S), RayPacking::Packet16, {});
+    const Mask mask = castCoverage(whole.get(), camera.scaled(S), RayPacking::Packet16, {});
     const ReferenceResult r =
         renderReference(surface, camera, PassSelection{.supersample = S}, {}, {.maskHint = &mask});
     const metrics::Outline nearby =
@@ -476,7 +485,7 @@ TEST(ReferenceCache, SecondRequestForTheSameViewReusesTheScene) {
   EXPECT_TRUE(second.stats.sceneCached);
   EXPECT_EQ(first.images.passes.at(pass::kColor).pixels,
             second.images.passes.at(pass::kColor).pixels);
-  EXPECT_EQ(first.images.supersampledMask.pixels, second.images.supersampledMask.pixels);
+  EXPECT_EQ(first.images.supersampledMask.covered, second.images.supersampledMask.covered);
   ReferenceSceneCache::Counters c = cache.counters();
   EXPECT_EQ(c.hits, 1u);
   EXPECT_EQ(c.misses, 1u);
@@ -519,7 +528,7 @@ void expectPathsAgree(const ControlMesh& m, Vec3 eye, int size, int S, const std
   Camera camera = viewOf(surface, size, eye);
   ReferenceResult r = renderReference(surface, camera, PassSelection{.supersample = S}, {});
   std::string whyNot;
-  std::optional<Image> embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot);
+  std::optional<Mask> embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot);
   ASSERT_TRUE(embree) << what << ": " << whyNot;
   ASSERT_GT(coverage(*embree), 0) << what;
   metrics::SilhouetteMetrics sm =
@@ -650,7 +659,7 @@ TEST(Reference, HoleLetsRaysThrough) {
   const Image& mask = r.images.passes.at(pass::kMask);
   EXPECT_EQ(mask.at(50, 50), 0.0f);
   EXPECT_EQ(mask.at(50, 30), 1.0f);
-  EXPECT_EQ(r.images.supersampledMask.at(101, 101), 0.0f);
+  EXPECT_EQ(r.images.supersampledMask.at(101, 101), 0);
 }
 
 TEST(Reference, WireframePassIsTheColourWithAWarning) {
@@ -692,7 +701,7 @@ TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
     const int size = 128, S = 4;
     Camera camera = viewOf(*surface, size, Vec3{0.3, 0.45, 0.85} * surface->bounds().diagonal());
     std::string whyNot;
-    std::optional<Image> embree = embreeSubdivisionMask(*surface, camera.scaled(S), {}, &whyNot);
+    std::optional<Mask> embree = embreeSubdivisionMask(*surface, camera.scaled(S), {}, &whyNot);
     if (!embree) {
       std::cout << "[ corpus   ] " << name << ": no cross-check: " << whyNot << "\n";
       continue;
@@ -797,7 +806,7 @@ void timeReference(const std::string& name, const ControlMesh& m, Vec3 offset, i
         build, p16, p1, m16, m1);
   }
   std::string whyNot;
-  std::optional<Image> embree;
+  std::optional<Mask> embree;
   double subdivMs =
       msOf([&] { embree = embreeSubdivisionMask(surface, camera.scaled(S), {}, &whyNot); });
   if (embree) {
