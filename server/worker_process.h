@@ -27,8 +27,10 @@ struct WorkerProcessOptions {
   // crash. 0: no ceiling.
   size_t maxMemoryBytes = 0;
   // How long a task may run on after its deadline (or cancellation) before its worker is
-  // killed: every stage checks its cancel token well within this.
-  std::chrono::milliseconds cancelGrace{2'000};
+  // killed: every stage checks its cancel token well within this. The longest step between
+  // checks (a 1024^2 comparison's first framebuffers and masks, before its first tile) took
+  // 1.5 s on the 2-core VM loaded three times over; a kill then would cost a restart.
+  std::chrono::milliseconds cancelGrace{5'000};
   std::chrono::milliseconds startTimeout{30'000};  // to make the GL context and say Ready
   // When set and true, a start still waiting for its Ready gives up (the pool is stopping).
   const std::atomic<bool>* abandonStart = nullptr;

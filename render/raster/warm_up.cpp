@@ -15,8 +15,10 @@ tessellate::TriangleMesh tetrahedron() {
 }
 
 LineOverlay edgesOf(const tessellate::TriangleMesh& mesh, bool occluded) {
-  LineOverlay overlay{.pass = occluded ? "warm-up-occluded" : "warm-up", .points = {},
-                      .colors = {}, .occluded = occluded};
+  LineOverlay overlay{.pass = occluded ? "warm-up-occluded" : "warm-up",
+                      .points = {},
+                      .colors = {},
+                      .occluded = occluded};
   for (size_t i = 0; i < mesh.indices.size(); i += 3) {
     overlay.points.push_back(mesh.positions[mesh.indices[i]]);
     overlay.points.push_back(mesh.positions[mesh.indices[i + 1]]);
@@ -32,8 +34,13 @@ void warmUp(Rasterizer& rasterizer) {
   const Camera camera({0, 0, 6}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 0.0, 16, 16,
                       0.1, 100.0);
   const std::vector<LineOverlay> overlays = {edgesOf(mesh, true), edgesOf(mesh, false)};
-  PassSelection every{.color = true, .mask = true, .depth = true, .normal = true,
-                      .wireframe = true, .supersample = 2, .antialias = 4};
+  PassSelection every{.color = true,
+                      .mask = true,
+                      .depth = true,
+                      .normal = true,
+                      .wireframe = true,
+                      .supersample = 2,
+                      .antialias = 4};
   rasterizer.render(mesh, camera, every, Shading::Smooth, overlays);
   every.antialias = 1;  // the single-sample colour path
   rasterizer.render(mesh, camera, every, Shading::Flat, overlays);

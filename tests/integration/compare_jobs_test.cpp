@@ -96,6 +96,19 @@ class CompareServer : public ::testing::Test {
     }
   }
 
+  static rapidjson::Document health() { return parse(get(port(), "/healthz").body); }
+  // /healthz once every worker is ready and none is busy (or after 60 s).
+  static rapidjson::Document wholePool() {
+    const auto deadline = Clock::now() + std::chrono::seconds(60);
+    for (;;) {
+      rapidjson::Document h = health();
+      const bool whole =
+          h["busyWorkers"].GetInt() == 0 && h["readyWorkers"].GetInt() == h["workers"].GetInt();
+      if (whole || Clock::now() > deadline) return h;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+
   static ServerProcess* server_;
 };
 ServerProcess* CompareServer::server_ = nullptr;
@@ -226,6 +239,7 @@ TEST_F(CompareServer, BadInputIsA4xxNamingTheField) {
 TEST_F(CompareServer, TheDeadlineCoversAllRows) {
   // Twelve rows at 1024^2 with the metrics' masks at S = 8 take far longer than
   // requestTimeoutMs (8 s): the comparison is answered 504, not after its last row.
+  const int crashesBefore = health()["workerCrashes"].GetInt();
   const auto start = Clock::now();
   HttpResponse r = post(port(), "/v1/compare",
                         R"({"mesh":)" + mesh("pawn") +
@@ -245,6 +259,13 @@ TEST_F(CompareServer, TheDeadlineCoversAllRows) {
                      R"(,"camera":{"width":32,"height":32},"methods":["coarse"]})")
                 .status,
             200);
+  // The timed-out worker stops at its cancellation (it is killed only when it does not, after
+  // a grace of seconds) and the pool is whole again for the next requests.
+  rapidjson::Document settled = wholePool();
+  EXPECT_EQ(settled["busyWorkers"].GetInt(), 0);
+  EXPECT_EQ(settled["readyWorkers"].GetInt(), settled["workers"].GetInt());
+  EXPECT_EQ(settled["workerCrashes"].GetInt(), crashesBefore)
+      << "the timed-out worker was killed instead of stopping at its cancellation";
 }
 
 std::string jobSpec(const std::string& meshJson, const std::string& methods, int views, int size) {
@@ -307,6 +328,7 @@ TEST_F(CompareServer, AJobComputesItsRowsAsComparisonsWouldAndCanBeReadInParts) 
 }
 
 TEST_F(CompareServer, JobsAreCancelledBoundedAndRunOnTheWorkers) {
+  const int crashesBefore = health()["workerCrashes"].GetInt();
   const std::string torus = mesh("torus_creased");
   const std::string slow = jobSpec(torus, R"(["coarse","uniform:3","silhouette"])", 12, 256);
   HttpResponse a = post(port(), "/v1/jobs", slow), b = post(port(), "/v1/jobs", slow);
@@ -326,7 +348,7 @@ TEST_F(CompareServer, JobsAreCancelledBoundedAndRunOnTheWorkers) {
   bool sawBusyWorker = false;
   const auto deadline = Clock::now() + std::chrono::seconds(120);
   while (Clock::now() < deadline && (!sawBusyWorker || job(first)["rows"].Size() == 0)) {
-    sawBusyWorker |= parse(get(port(), "/healthz").body)["busyWorkers"].GetInt() > 0;
+    sawBusyWorker |= health()["busyWorkers"].GetInt() > 0;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_TRUE(sawBusyWorker) << "the job's rows are made on the render workers";
@@ -348,6 +370,8 @@ TEST_F(CompareServer, JobsAreCancelledBoundedAndRunOnTheWorkers) {
   EXPECT_EQ(next.status, 202);
   EXPECT_STREQ(finished(parse(next.body)["id"].GetString())["state"].GetString(), "done");
   EXPECT_EQ(get(port(), "/v1/jobs/" + first).status, 404);
+  EXPECT_EQ(wholePool()["workerCrashes"].GetInt(), crashesBefore)
+      << "a cancelled job's worker was killed instead of stopping";
 }
 
 TEST_F(CompareServer, AJobSpecIsCheckedBeforeItIsQueued) {
