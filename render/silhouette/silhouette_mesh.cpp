@@ -192,6 +192,41 @@ size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, Fa
   return before - piece.triangles.size();
 }
 
+// The boundary of a face of more than four sides (its corners and edge points, counter-
+// clockwise in (u, v)), triangulated where it lies: ear-clipped in the plane that fits it best
+// (Newell's normal), with the triangles' corners in the boundary's order as a fan's are. The
+// face's domain is a regular polygon, convex, and so is any triangulation made in it, but the
+// face need not be: the flat cap of a gear is a concave 64-gon, and a triangulation of its
+// domain drew chords from one tooth to the next across the gaps between them (the held-out
+// workshop from below, 17.6 px outside the outline).
+std::vector<std::array<int, 3>> clipBoundaryInSpace(const std::vector<FacePoint>& boundary) {
+  const int n = static_cast<int>(boundary.size());
+  Vec3 normal{0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    const Vec3& a = boundary[i].position;
+    const Vec3& b = boundary[(i + 1) % n].position;
+    normal += Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+  }
+  std::vector<std::array<int, 3>> triangles;
+  if (!(length(normal) > 0)) {  // no plane to clip in
+    for (int k = 1; k + 1 < n; ++k) triangles.push_back({0, k, k + 1});
+    return triangles;
+  }
+  normal = normalize(normal);
+  // Axes with x cross y = the normal: the boundary, counter-clockwise about its Newell normal,
+  // is counter-clockwise in the plane, as earClip wants it.
+  const Vec3 helper = std::abs(normal.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  const Vec3 xAxis = normalize(cross(helper, normal)), yAxis = cross(normal, xAxis);
+  std::vector<Vec2> planar(n);
+  std::vector<int> polygon(n);
+  for (int i = 0; i < n; ++i) {
+    planar[i] = {dot(boundary[i].position, xAxis), dot(boundary[i].position, yAxis)};
+    polygon[i] = i;
+  }
+  earClip(planar, polygon, triangles);
+  return triangles;
+}
+
 FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const ContourSearch& search,
                     const ChordRefinement& chords, const SilhouetteOptions& options, int face) {
   const subdiv::LimitSurface& surface = domains.surface();
@@ -206,7 +241,11 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
     piece.points = boundary.points;  // fall back to clipping the boundary alone
   }
   if (boundary.edgePointCount == 0) {
-    for (int k = 1; k + 1 < corners; ++k) piece.triangles.push_back({0, k, k + 1});
+    if (corners > 4) {
+      piece.triangles = clipBoundaryInSpace(boundary.points);
+    } else {
+      for (int k = 1; k + 1 < corners; ++k) piece.triangles.push_back({0, k, k + 1});
+    }
     return piece;
   }
   piece.corrected = true;
@@ -236,7 +275,10 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
   std::vector<Vec2> uv;
   uv.reserve(piece.points.size());
   for (const FacePoint& p : piece.points) uv.push_back(p.uv);
-  piece.triangles = triangulateFace(uv, static_cast<int>(boundary.points.size()), paths);
+  // Contour curves cut the face in its domain; a face without any is clipped where it lies.
+  piece.triangles = paths.empty() && corners > 4
+                        ? clipBoundaryInSpace(boundary.points)
+                        : triangulateFace(uv, static_cast<int>(boundary.points.size()), paths);
   // Only exact curves lie on the surface; a chord ending at a pn sample (off the surface) would
   // never come within tolerance, so pn faces keep their ear-clipped triangles.
   // Faces along an infinitely sharp interior edge are left as clipped: the surface can pinch
