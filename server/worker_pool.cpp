@@ -280,7 +280,10 @@ void WorkerPool::threadWorkerMain(size_t slot) {
   std::unique_ptr<render::raster::Rasterizer> rasterizer;
   try {
     rasterizer = std::make_unique<render::raster::Rasterizer>();
-    render::raster::warmUp(*rasterizer);
+    if (!render::raster::warmUp(*rasterizer)) {
+      std::cerr << "limn: a render worker's shader warm-up failed; its first requests compile "
+                   "the shaders instead\n";
+    }
     status.ready = true;
     status.device = rasterizer->device();
   } catch (const std::exception& e) {

@@ -235,7 +235,10 @@ int workerMain(int fd) {
   wire::Ready ready;
   try {
     rasterizer = std::make_unique<render::raster::Rasterizer>();
-    render::raster::warmUp(*rasterizer);
+    if (!render::raster::warmUp(*rasterizer)) {
+      std::cerr << "limn: a render worker's shader warm-up failed; its first requests compile "
+                   "the shaders instead\n";
+    }
     ready.ok = true;
     ready.device = rasterizer->device();
   } catch (const std::exception& e) {

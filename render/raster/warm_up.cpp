@@ -1,5 +1,6 @@
 #include "render/raster/warm_up.h"
 
+#include <exception>
 #include <vector>
 
 namespace limn::render::raster {
@@ -29,7 +30,7 @@ LineOverlay edgesOf(const tessellate::TriangleMesh& mesh, bool occluded) {
 
 }  // namespace
 
-void warmUp(Rasterizer& rasterizer) {
+bool warmUp(Rasterizer& rasterizer) noexcept try {
   const tessellate::TriangleMesh mesh = tetrahedron();
   const Camera camera({0, 0, 6}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 0.0, 16, 16,
                       0.1, 100.0);
@@ -44,6 +45,9 @@ void warmUp(Rasterizer& rasterizer) {
   rasterizer.render(mesh, camera, every, Shading::Smooth, overlays);
   every.antialias = 1;  // the single-sample colour path
   rasterizer.render(mesh, camera, every, Shading::Flat, overlays);
+  return true;
+} catch (const std::exception&) {
+  return false;
 }
 
 }  // namespace limn::render::raster

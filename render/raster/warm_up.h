@@ -10,8 +10,9 @@
 namespace limn::render::raster {
 
 // Draws a tetrahedron at 16^2 with each pass and shading the pipeline uses (anti-aliased
-// colour, mask, depth, normal, wireframe, line overlays, a supersampled mask). Throws what
-// Rasterizer::render() throws.
-void warmUp(Rasterizer& rasterizer);
+// colour, mask, depth, normal, wireframe, line overlays, a supersampled mask). Returns false
+// when a draw failed: the warm-up only saves time, so a worker goes on without it (its first
+// requests compile what is left) rather than being taken out of service.
+bool warmUp(Rasterizer& rasterizer) noexcept;
 
 }  // namespace limn::render::raster
