@@ -2,10 +2,13 @@
 
 #include <malloc.h>
 
+#include <iostream>
+
 #include "api/compare_api.h"
 #include "api/implicit_api.h"
 #include "api/render_api.h"
 #include "api/silhouette_api.h"
+#include "render/raster/warm_up.h"
 
 namespace limn::server {
 
@@ -57,6 +60,15 @@ const char* endpointPath(Endpoint endpoint) {
 void returnFreedMemoryAfter(double seconds) {
   constexpr double kTrimAfterSeconds = 0.2;
   if (seconds > kTrimAfterSeconds) ::malloc_trim(0);
+}
+
+std::unique_ptr<render::raster::Rasterizer> startRasterizer() {
+  auto rasterizer = std::make_unique<render::raster::Rasterizer>();
+  if (!render::raster::warmUp(*rasterizer)) {
+    std::cerr << "limn: a render worker's shader warm-up failed; its first requests compile "
+                 "the shaders instead\n";
+  }
+  return rasterizer;
 }
 
 }  // namespace limn::server

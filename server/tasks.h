@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -13,6 +14,7 @@
 #include "render/core/cancel.h"
 #include "render/mesh/mesh_cache.h"
 #include "render/pipeline/render_job.h"
+#include "render/raster/rasterizer.h"
 
 namespace limn::server {
 
@@ -38,6 +40,11 @@ api::Answer runTask(const Task& task, const render::pipeline::JobLimits& limits,
 std::optional<std::string> referencedMeshId(const Task& task);
 
 const char* endpointPath(Endpoint endpoint);
+
+// A render worker's rasteriser: its GL context, with the shaders warmed up
+// (render/raster/warm_up.h; a failed warm-up is said on stderr and the worker goes on without
+// it). Throws what the Rasterizer constructor throws when no context can be made.
+std::unique_ptr<render::raster::Rasterizer> startRasterizer();
 
 // After a task that ran `seconds`, hands the memory it freed back to the system when the task
 // was long: a reference at 1024^2 leaves about a gigabyte freed but resident in glibc's arenas

@@ -12,7 +12,7 @@
 #include <iostream>
 #include <utility>
 
-#include "render/raster/warm_up.h"
+#include "server/tasks.h"
 
 namespace limn::server {
 
@@ -279,11 +279,7 @@ void WorkerPool::threadWorkerMain(size_t slot) {
   WorkerStatus status;
   std::unique_ptr<render::raster::Rasterizer> rasterizer;
   try {
-    rasterizer = std::make_unique<render::raster::Rasterizer>();
-    if (!render::raster::warmUp(*rasterizer)) {
-      std::cerr << "limn: a render worker's shader warm-up failed; its first requests compile "
-                   "the shaders instead\n";
-    }
+    rasterizer = startRasterizer();
     status.ready = true;
     status.device = rasterizer->device();
   } catch (const std::exception& e) {

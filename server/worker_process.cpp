@@ -17,7 +17,6 @@
 #include <thread>
 
 #include "render/raster/rasterizer.h"
-#include "render/raster/warm_up.h"
 #include "server/tasks.h"
 
 namespace limn::server {
@@ -234,11 +233,7 @@ int workerMain(int fd) {
   std::unique_ptr<render::raster::Rasterizer> rasterizer;
   wire::Ready ready;
   try {
-    rasterizer = std::make_unique<render::raster::Rasterizer>();
-    if (!render::raster::warmUp(*rasterizer)) {
-      std::cerr << "limn: a render worker's shader warm-up failed; its first requests compile "
-                   "the shaders instead\n";
-    }
+    rasterizer = startRasterizer();
     ready.ok = true;
     ready.device = rasterizer->device();
   } catch (const std::exception& e) {

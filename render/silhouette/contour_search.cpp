@@ -203,8 +203,6 @@ std::vector<int> findLoopFaces(const FaceDomains& domains, const Camera& camera,
   return faces;
 }
 
-}  // namespace
-
 // The face's own limit normal at its corner `k` where it differs from the vertex's (a sharp
 // feature), taken a hair inside the face. At the corner itself Bfr's normal is the cross product
 // of the derivatives along the face's two edges, which points the wrong way where the face's
@@ -212,13 +210,15 @@ std::vector<int> findLoopFaces(const FaceDomains& domains, const Camera& camera,
 // sharp edges (a gear's cap between two teeth) read (0, +1, 0) on a cap facing (0, -1, 0), and
 // the edge search found contour curves on a flat cap whose triangles then spanned the gaps
 // between the teeth (20 px on a scene of gears).
-static Vec3 faceNormalAtCorner(const FaceDomains& domains, int face, int k) {
+Vec3 faceNormalAtCorner(const FaceDomains& domains, int face, int k) {
   constexpr double kInside = 1e-4;  // of the way from the corner to the face's centre in (u, v)
   const Vec2 corner = domains.corner(face, k), centre = domains.center(face);
   const Vec2 uv{corner.x + kInside * (centre.x - corner.x),
                 corner.y + kInside * (centre.y - corner.y)};
   return domains.evaluate(face, uv).normal;
 }
+
+}  // namespace
 
 ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
                             const SearchOptions& options, const CancelToken& cancel) {
