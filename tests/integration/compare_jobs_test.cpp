@@ -408,7 +408,7 @@ TEST_F(CompareServer, RealAnswersMatchTheOpenApiDocument) {
       {"POST", "/v1/compare", "",
        R"({"mesh":)" + cube +
            R"(,"cameras":[{"width":40,"height":40},{"orbit":{"azimuthDeg":10},"width":40,"height":40}],)"
-           R"("methods":["coarse",{"method":"uniform","params":{"level":6}},{"method":"silhouette","label":"s"}],)"
+           R"("methods":["coarse",{"method":"uniform","params":{"level":3}},{"method":"silhouette","label":"s"}],)"
            R"("outputs":["color","diff"],"imageFormat":"png"})"},
       {"POST", "/v1/compare", "", R"({"mesh":)" + cube + R"(,"methods":["limit"]})"},
       {"POST", "/v1/compare", "",
