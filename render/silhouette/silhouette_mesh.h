@@ -6,7 +6,7 @@
 //   searchContour   edges -> edge points where g = dot(n, p - eye) changes sign
 //   faceCurves      per face: crossings paired, curves sampled ("pn" or "exact")
 //   refineConcaveChords  one ring out: points where a chord would lie outside the surface
-//   triangulateFace per face with edge points: regions cut by the curves, ear-clipped in (u, v)
+//   triangulateFace per face with edge points: regions cut by the curves, Delaunay in (u, v)
 // Faces with no edge point keep their corners: quads as two triangles, triangles as one.
 #pragma once
 

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "render/silhouette/contour_search.h"
@@ -317,6 +319,59 @@ TEST(FaceTriangulation, CoversTheFaceWithStraightRunsKept) {
   EXPECT_NEAR(area, 1.0, 1e-12);
   for (size_t i = 0; i < uv.size(); ++i) EXPECT_GT(used[i], 0) << "point " << i << " unused";
   // No triangle crosses the curve 1 -> 7 -> 8 -> 5: each lies on one side of it.
+}
+
+TEST(FaceTriangulation, CutsRegionsIntoDelaunayTrianglesNotFans) {
+  // A contour curve across the top of a quad's domain, sampled densely, as on a bottle's neck:
+  // clipped into ears alone, the region below it is a fan of long chords from one corner, each
+  // sagging off the surface. Every diagonal inside a region must be locally Delaunay.
+  std::vector<Vec2> uv = {{0, 0}, {1, 0}, {1, 0.8}, {1, 1}, {0, 1}, {0, 0.8}};
+  CurvePath curve{5, 2, {}};
+  for (int i = 1; i < 16; ++i) {
+    const double x = i / 16.0;
+    curve.interior.push_back(static_cast<int>(uv.size()));
+    uv.push_back({x, 0.8 + 0.1 * std::sin(3.14159265358979 * x)});
+  }
+  std::vector<std::array<int, 3>> triangles = triangulateFace(uv, 6, {curve});
+  std::set<std::pair<int, int>> constrained;
+  for (int i = 0; i < 6; ++i) constrained.insert(std::minmax(i, (i + 1) % 6));
+  std::vector<int> chain{curve.from};
+  chain.insert(chain.end(), curve.interior.begin(), curve.interior.end());
+  chain.push_back(curve.to);
+  for (size_t i = 0; i + 1 < chain.size(); ++i)
+    constrained.insert(std::minmax(chain[i], chain[i + 1]));
+
+  double area = 0;
+  std::map<std::pair<int, int>, int> opposite;  // directed edge -> the corner across from it
+  int mostTriangles = 0;
+  std::vector<int> trianglesAt(uv.size(), 0);
+  for (const auto& t : triangles) {
+    area += 0.5 * ((uv[t[1]].x - uv[t[0]].x) * (uv[t[2]].y - uv[t[0]].y) -
+                   (uv[t[1]].y - uv[t[0]].y) * (uv[t[2]].x - uv[t[0]].x));
+    for (int k = 0; k < 3; ++k) {
+      opposite[{t[k], t[(k + 1) % 3]}] = t[(k + 2) % 3];
+      mostTriangles = std::max(mostTriangles, ++trianglesAt[t[k]]);
+    }
+  }
+  EXPECT_NEAR(area, 1.0, 1e-12);
+  int diagonals = 0;
+  for (const auto& [edge, r] : opposite) {
+    auto across = opposite.find({edge.second, edge.first});
+    if (across == opposite.end() || constrained.count(std::minmax(edge.first, edge.second)))
+      continue;
+    ++diagonals;
+    const Vec2 &a = uv[edge.first], &b = uv[edge.second], &c = uv[r], &d = uv[across->second];
+    // d inside the circle through a, b, c (counter-clockwise) would make the diagonal a-b flip.
+    const double ax = a.x - d.x, ay = a.y - d.y, bx = b.x - d.x, by = b.y - d.y;
+    const double cx = c.x - d.x, cy = c.y - d.y;
+    const double inCircle = (ax * ax + ay * ay) * (bx * cy - cx * by) -
+                            (bx * bx + by * by) * (ax * cy - cx * ay) +
+                            (cx * cx + cy * cy) * (ax * by - bx * ay);
+    EXPECT_LE(inCircle, 1e-12) << "diagonal " << edge.first << "-" << edge.second;
+  }
+  EXPECT_GT(diagonals, 0);
+  // A fan puts all 17 triangles below the curve on one corner.
+  EXPECT_LT(mostTriangles, 10);
 }
 
 TEST(Presubdivide, KeepsTheLimitSurface) {
