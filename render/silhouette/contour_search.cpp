@@ -218,6 +218,42 @@ Vec3 faceNormalAtCorner(const FaceDomains& domains, int face, int k) {
   return domains.evaluate(face, uv).normal;
 }
 
+// Distance in the image from p to the segment a-b (pixels; x and y of projected points).
+double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
+  const double t =
+      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+// The fewest uniform segments along an outline edge's limit curve whose chords stay within
+// `tolerancePx` of it in the image, judged at `dense` uniform samples (the most it returns).
+// A straight crease (a shelf's board, a box's edge) needs no interior point at all, where one
+// every two pixels tripled the triangles of a piecewise flat model; a curved one needs about
+// the square root of its sag over the tolerance.
+int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, int edge,
+                    int dense, double tolerancePx) {
+  auto imageAt = [&](double t) {
+    return camera.project(domains.position(face, edgeUV(domains, face, edge, t)));
+  };
+  std::vector<Vec3> samples(dense + 1);
+  for (int i = 0; i <= dense; ++i) samples[i] = imageAt(static_cast<double>(i) / dense);
+  for (int n = 1; n < dense; n *= 2) {
+    std::vector<Vec3> chords(n + 1);
+    for (int j = 0; j <= n; ++j) {
+      chords[j] = j == 0 ? samples.front() : j == n ? samples.back() : imageAt(static_cast<double>(j) / n);
+    }
+    bool within = true;
+    for (int i = 1; i < dense && within; ++i) {
+      const double t = static_cast<double>(i) / dense;
+      const int j = std::min(n - 1, static_cast<int>(t * n));
+      within = distanceToSegmentPx(samples[i], chords[j], chords[j + 1]) <= tolerancePx;
+    }
+    if (within) return n;
+  }
+  return dense;
+}
+
 }  // namespace
 
 ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
@@ -359,6 +395,10 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
         if (probe.onTables()) ++onTables;
         if (!split) break;  // one face sees the whole edge
       }
+      int owner = -1;  // the edge's first face with a limit surface: it positions the points
+      for (int k = 0; k < faces.size() && owner < 0; ++k) {
+        if (allSides >> k & 1u) owner = faces[k];
+      }
       // Outline edges: shaped along their limit curve wherever they could show.
       const bool outline = validFaces == 1 || (crease && (sideSignsDiffer || !found.empty()));
       if (outline) {
@@ -368,6 +408,10 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
         double pixels = std::hypot(a.x - b.x, a.y - b.y);
         int segments = std::clamp(static_cast<int>(std::ceil(pixels / options.pixelsPerSample)), 1,
                                   std::max(1, options.outlineSamples + 1));
+        if (segments > 1) {
+          segments = outlineSegments(domains, camera, owner, static_cast<int>(e), segments,
+                                     options.outlineTolerancePx);
+        }
         for (int i = 1; i < segments; ++i) {
           found.push_back({static_cast<double>(i) / segments, {}, 0u});
         }
@@ -380,10 +424,6 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
       std::sort(found.begin(), found.end(),
                 [](const EdgePoint& a, const EdgePoint& b) { return a.t < b.t; });
       std::vector<EdgePoint>& points = out.edgePoints[e];
-      int owner = -1;
-      for (int k = 0; k < faces.size() && owner < 0; ++k) {
-        if (allSides >> k & 1u) owner = faces[k];
-      }
       for (const EdgePoint& p : found) {
         if (!points.empty() && p.t - points.back().t < 1e-9) {
           points.back().sides |= p.sides;

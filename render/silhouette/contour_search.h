@@ -38,10 +38,13 @@ struct SearchOptions {
   int searchSteps = 5;  // bisection steps before the final linear interpolation
   int edgeSamples = 4;  // intervals sampled on an edge the bound cannot clear
   // Outline edges (boundaries, and infinitely sharp creases seen front on one side and back on
-  // the other) are part of the outline: they get points along their limit curve about every
-  // `pixelsPerSample` pixels, at most `outlineSamples` per edge.
+  // the other) are part of the outline: their limit curve is sampled about every
+  // `pixelsPerSample` pixels, at most `outlineSamples` per edge, and they get the fewest uniform
+  // points whose chords stay within `outlineTolerancePx` of those samples in the image (none on
+  // a straight edge).
   double pixelsPerSample = 2.0;
   int outlineSamples = 32;
+  double outlineTolerancePx = 0.05;
   // True: g at the dyadic parameters the sampling and bisection reach (multiples of 1/128)
   // comes from the edge tables (edge_tables.h) on the edges they cover, rather than from Bfr;
   // the same values to rounding. Off by default: the search evaluates only about 4 such points

@@ -302,6 +302,30 @@ TEST(SilhouetteMesh, IsWatertightOnClosedMeshes) {
   }
 }
 
+// Outline edges (boundaries, sharp creases at the outline) are shaped by points along their
+// limit curve only where it bends: a sharp cube's straight edges need none (one every two
+// pixels tripled a piecewise flat model's triangles), a wavy sheet's curved boundary keeps some.
+TEST(ContourSearch, OutlineEdgesArePointedOnlyWhereTheyBend) {
+  auto shapingPoints = [](const ControlMesh& cage, size_t* outlineEdges) {
+    subdiv::LimitSurface surface(cage);
+    CameraSpec spec = obliqueView();
+    spec.width = spec.height = 1024;
+    Camera camera = resolveCamera(spec, surface.bounds());
+    SilhouetteMesh result = buildSilhouetteMesh(surface, camera, SilhouetteOptions{}, CancelToken());
+    *outlineEdges = result.stats.search.outlineEdges;
+    size_t points = 0;
+    for (const auto& edge : result.search.edgePoints) {
+      for (const EdgePoint& p : edge) points += p.sides == 0;
+    }
+    return points;
+  };
+  size_t outlineEdges = 0;
+  EXPECT_EQ(shapingPoints(limn::testing::sharpCube(), &outlineEdges), 0u);
+  EXPECT_GT(outlineEdges, 0u);
+  EXPECT_GT(shapingPoints(limn::testing::grid(4, 0.4), &outlineEdges), 0u);
+  EXPECT_GT(outlineEdges, 0u);
+}
+
 TEST(FaceTriangulation, CoversTheFaceWithStraightRunsKept) {
   // Unit square with two extra points on its bottom edge and a curve from the bottom to the top.
   std::vector<Vec2> uv = {{0, 0},   {0.3, 0}, {0.6, 0},    {1, 0},     {1, 1},
