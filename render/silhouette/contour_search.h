@@ -44,7 +44,7 @@ struct SearchOptions {
   // a straight edge).
   double pixelsPerSample = 2.0;
   int outlineSamples = 32;
-  double outlineTolerancePx = 0.05;
+  double outlineTolerancePx = 0.01;
   // True: g at the dyadic parameters the sampling and bisection reach (multiples of 1/128)
   // comes from the edge tables (edge_tables.h) on the edges they cover, rather than from Bfr;
   // the same values to rounding. Off by default: the search evaluates only about 4 such points
