@@ -231,8 +231,8 @@ double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b) {
 // A straight crease (a shelf's board, a box's edge) needs no interior point at all, where one
 // every two pixels tripled the triangles of a piecewise flat model; a curved one needs about
 // the square root of its sag over the tolerance.
-int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, int edge,
-                    int dense, double tolerancePx) {
+int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, int edge, int dense,
+                    double tolerancePx) {
   auto imageAt = [&](double t) {
     return camera.project(domains.position(face, edgeUV(domains, face, edge, t)));
   };
@@ -241,7 +241,9 @@ int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, 
   for (int n = 1; n < dense; n *= 2) {
     std::vector<Vec3> chords(n + 1);
     for (int j = 0; j <= n; ++j) {
-      chords[j] = j == 0 ? samples.front() : j == n ? samples.back() : imageAt(static_cast<double>(j) / n);
+      chords[j] = j == 0   ? samples.front()
+                  : j == n ? samples.back()
+                           : imageAt(static_cast<double>(j) / n);
     }
     bool within = true;
     for (int i = 1; i < dense && within; ++i) {

@@ -311,7 +311,8 @@ TEST(ContourSearch, OutlineEdgesArePointedOnlyWhereTheyBend) {
     CameraSpec spec = obliqueView();
     spec.width = spec.height = 1024;
     Camera camera = resolveCamera(spec, surface.bounds());
-    SilhouetteMesh result = buildSilhouetteMesh(surface, camera, SilhouetteOptions{}, CancelToken());
+    SilhouetteMesh result =
+        buildSilhouetteMesh(surface, camera, SilhouetteOptions{}, CancelToken());
     *outlineEdges = result.stats.search.outlineEdges;
     size_t points = 0;
     for (const auto& edge : result.search.edgePoints) {
