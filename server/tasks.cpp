@@ -62,6 +62,13 @@ void returnFreedMemoryAfter(double seconds) {
   if (seconds > kTrimAfterSeconds) ::malloc_trim(0);
 }
 
+void keepFreedMemoryForReuse() {
+  constexpr int kHeapBlockBytes = 32 << 20;
+  constexpr int kKeptAtTopBytes = 128 << 20;
+  ::mallopt(M_MMAP_THRESHOLD, kHeapBlockBytes);
+  ::mallopt(M_TRIM_THRESHOLD, kKeptAtTopBytes);
+}
+
 std::unique_ptr<render::raster::Rasterizer> startRasterizer() {
   auto rasterizer = std::make_unique<render::raster::Rasterizer>();
   if (!render::raster::warmUp(*rasterizer)) {

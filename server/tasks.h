@@ -52,4 +52,11 @@ std::unique_ptr<render::raster::Rasterizer> startRasterizer();
 // few milliseconds.
 void returnFreedMemoryAfter(double seconds);
 
+// Keeps memory freed by one task in the process for the next: blocks up to 32 MiB come from the
+// heap, not from their own mappings, and up to 128 MiB freed at the heap's top stays. Fresh
+// pages cost dearly in a VM (about 4 ms per MB touched here): glibc's defaults gave back and
+// faulted in again the megabytes of images and buffers of every small render. Long tasks still
+// return what they freed (returnFreedMemoryAfter).
+void keepFreedMemoryForReuse();
+
 }  // namespace limn::server

@@ -232,6 +232,7 @@ WorkerPool::WorkerPool(const PoolOptions& options) : options_(options) {
   if (options_.isolation == Isolation::Thread) {
     sharedReferenceCache_ =
         std::make_unique<render::oracle::ReferenceSceneCache>(options_.referenceCacheBytes);
+    keepFreedMemoryForReuse();  // tasks run in this process (worker processes call it too)
   }
   status_.resize(count);
   assigned_.resize(count);

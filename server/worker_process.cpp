@@ -225,6 +225,7 @@ class CurrentTask {
 }  // namespace
 
 int workerMain(int fd) {
+  keepFreedMemoryForReuse();
   std::optional<std::string> frame = wire::readFrame(fd);
   if (!frame) return 1;
   const wire::WorkerConfig config = wire::decodeConfig(*frame);
