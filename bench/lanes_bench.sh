@@ -10,6 +10,7 @@
 #   LIMN_BENCH_CONFIG='"reservedInteractiveWorkers": 0, "heavyRequestMs": 1000000000'
 #       adds configuration keys (that one: one FIFO lane, as limn was before lanes)
 #   LIMN_BENCH_RUNS="mixed"   only the mixed run (default: "small heavy mixed")
+#   ANTIALIAS=1               every request drawn with one sample per pixel (default: 4)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 duration="${1:-60s}"
@@ -21,6 +22,13 @@ trap 'kill $server 2>/dev/null || true; rm -rf "$work"' EXIT
 
 # The 5,000-face torus: 100 x 50 quads.
 /usr/bin/python3 bench/load/requests.py "$work" 100 50
+# ANTIALIAS=N: every request's "antialias" (default: the server's, 4).
+if [ -n "${ANTIALIAS:-}" ]; then
+  for kind in small heavy; do
+    /usr/bin/python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); r["antialias"] = int(sys.argv[2]); json.dump(r, open(sys.argv[1], "w"))' \
+      "$work/$kind.json" "$ANTIALIAS"
+  done
+fi
 
 for kind in small heavy; do
   cat > "$work/$kind.lua" <<LUA
