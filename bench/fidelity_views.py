@@ -242,8 +242,11 @@ def report(args, results):
     tuned = [v for v in results if not v["heldOut"]]
     held = [v for v in results if v["heldOut"]]
     models = len({v["model"] for v in results})
-    out = ["`python3 bench/fidelity_views.py --size %d --views %d --seed %d --max-level %d`: %d models, %d views." % (
-        args.size, args.views, args.seed, args.max_level, models, len(results)), ""]
+    # A saved run's own settings are not in its file: name the file instead.
+    command = ("--from-json %s" % args.from_json if args.from_json else
+               "--size %d --views %d --seed %d --max-level %d" % (args.size, args.views, args.seed,
+                                                                  args.max_level))
+    out = ["`python3 bench/fidelity_views.py %s`: %d models, %d views." % (command, models, len(results)), ""]
     out += summarise(results, "All models") + [""]
     if tuned and held:
         out += summarise(tuned, "Models used while tuning") + [""]
