@@ -1,7 +1,9 @@
 #include "server/tasks.h"
 
 #include <malloc.h>
+#include <unistd.h>
 
+#include <fstream>
 #include <iostream>
 
 #include "api/compare_api.h"
@@ -57,9 +59,15 @@ const char* endpointPath(Endpoint endpoint) {
   return "?";
 }
 
-void returnFreedMemoryAfter(double seconds) {
-  constexpr double kTrimAfterSeconds = 0.2;
-  if (seconds > kTrimAfterSeconds) ::malloc_trim(0);
+void trimFreedMemoryAbove(size_t keepBytes) {
+  std::ifstream statm("/proc/self/statm");
+  size_t pages = 0, resident = 0;
+  if (!(statm >> pages >> resident)) return;
+  if (resident * static_cast<size_t>(::sysconf(_SC_PAGESIZE)) > keepBytes) ::malloc_trim(0);
+}
+
+size_t keptWorkerMemoryBytes(size_t ceilingBytes) {
+  return ceilingBytes > 0 ? ceilingBytes / 4 : size_t{1} << 30;
 }
 
 void keepFreedMemoryForReuse() {

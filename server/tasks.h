@@ -46,17 +46,23 @@ const char* endpointPath(Endpoint endpoint);
 // it). Throws what the Rasterizer constructor throws when no context can be made.
 std::unique_ptr<render::raster::Rasterizer> startRasterizer();
 
-// After a task that ran `seconds`, hands the memory it freed back to the system when the task
-// was long: a reference at 1024^2 leaves about a gigabyte freed but resident in glibc's arenas
-// (which a worker process' memory ceiling would count); after a small task it is not worth the
-// few milliseconds.
-void returnFreedMemoryAfter(double seconds);
+// After a task, hands the memory the process freed back to the system (`malloc_trim`) when it
+// holds more than `keepBytes` resident; below that the next task reuses it. A 1024^2
+// comparison leaves about a gigabyte freed but resident in glibc's arenas, and faulting it in
+// again is most of a request's time in a VM: the pawn's adaptive tessellation took 243 ms
+// after a trim against 39 ms without one (bench/load_results.md).
+void trimFreedMemoryAbove(size_t keepBytes);
+
+// What a render worker keeps resident between tasks before it trims: a quarter of its memory
+// ceiling (`maxWorkerMemoryBytes`; the ceiling counts resident memory, and a kept gigabyte
+// is reused, not added to, by the next task), or 1 GiB where there is no ceiling.
+size_t keptWorkerMemoryBytes(size_t ceilingBytes);
 
 // Keeps memory freed by one task in the process for the next: blocks up to 32 MiB come from the
 // heap, not from their own mappings, and up to 128 MiB freed at the heap's top stays. Fresh
 // pages cost dearly in a VM (about 4 ms per MB touched here): glibc's defaults gave back and
-// faulted in again the megabytes of images and buffers of every small render. Long tasks still
-// return what they freed (returnFreedMemoryAfter).
+// faulted in again the megabytes of images and buffers of every small render. What a task
+// leaves beyond keptWorkerMemoryBytes is returned (trimFreedMemoryAbove).
 void keepFreedMemoryForReuse();
 
 }  // namespace limn::server

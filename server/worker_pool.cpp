@@ -747,7 +747,9 @@ void WorkerPool::finishJob(size_t slot, const std::shared_ptr<Job>& job, api::An
   job->task = {};
   if (reply) reply(std::move(answer));
   // A worker process trims its own memory.
-  if (options_.isolation == Isolation::Thread) returnFreedMemoryAfter(seconds);
+  if (options_.isolation == Isolation::Thread) {
+    trimFreedMemoryAbove(keptWorkerMemoryBytes(options_.limits.maxWorkerMemoryBytes));
+  }
 }
 
 void WorkerPool::watchdogMain() {

@@ -264,7 +264,6 @@ int workerMain(int fd) {
   context.referenceCache = &referenceCache;
   for (;;) {
     auto [run, token] = current.take();
-    const auto start = Clock::now();
     wire::AnswerMessage message;
     if (!rasterizer) {
       message.answer = api::errorAnswer({503, "unavailable", "no OpenGL context: " + ready.error});
@@ -277,7 +276,7 @@ int workerMain(int fd) {
     current.finished();
     message.referenceCache = referenceCache.counters();
     if (!wire::writeAnswer(fd, message)) return 0;
-    returnFreedMemoryAfter(std::chrono::duration<double>(Clock::now() - start).count());
+    trimFreedMemoryAbove(keptWorkerMemoryBytes(config.limits.maxWorkerMemoryBytes));
   }
 }
 
