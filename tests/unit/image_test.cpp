@@ -66,6 +66,13 @@ TEST(ImageEncode, PngColorRoundTripWithinOneLevel) {
   Image grey(1, 1, 4, 0.5f);
   EXPECT_EQ(to8Bit(grey, pass::kColor), (std::vector<uint8_t>{188, 188, 188, 128}));
   EXPECT_EQ(to8Bit(grey, pass::kDiff), (std::vector<uint8_t>{128, 128, 128, 128}));
+  // Out of range and NaN clamp, in colour channels and alpha alike; 3 channels have no alpha.
+  Image edges(2, 1, 4);
+  edges.pixels = {-0.5f, 0.0f, 1.0f, std::nanf(""), 2.0f, 1e-9f, 0.999999f, 1.5f};
+  EXPECT_EQ(to8Bit(edges, pass::kColor), (std::vector<uint8_t>{0, 0, 255, 0, 255, 0, 255, 255}));
+  Image rgb(2, 1, 3);
+  rgb.pixels = {0.5f, std::nanf(""), 3.0f, 0.0f, 0.5f, -1.0f};
+  EXPECT_EQ(to8Bit(rgb, pass::kColor), (std::vector<uint8_t>{188, 0, 255, 0, 188, 0}));
   // Row 0 stays the top row.
   EXPECT_NEAR(back.at(0, 8, 1), 1.0f, 1e-6f);
   EXPECT_NEAR(back.at(0, 0, 1), 0.0f, 1e-6f);
