@@ -92,6 +92,8 @@ void writeMetrics(Writer& w, const render::metrics::Metrics& m) {
     if (m.silhouette->outlineHausdorffPx) {
       numberField(w, "outlineHausdorffPx", *m.silhouette->outlineHausdorffPx);
       numberField(w, "outlineMeanPx", m.silhouette->outlineMeanPx.value_or(0.0));
+      w.Key("outlineUnresolvedLoops");
+      w.Int64(m.silhouette->outlineUnresolvedLoops);
     }
     w.EndObject();
   }

@@ -20,6 +20,8 @@ struct SilhouetteMetrics {
   // Distances between the two outlines as curves in the image plane, output pixels, not
   // quantised by the supersampling (outline.h); absent where no outline was located.
   std::optional<double> outlineHausdorffPx, outlineMeanPx;
+  // Closed loops of either outline narrower than the reference resolves, not measured in those.
+  long outlineUnresolvedLoops = 0;
 };
 struct ColorMetrics {
   double rmse = 0, psnr = 0;

@@ -53,8 +53,9 @@ Outline locateOutline(const Mask& supersampledMask, int supersample, const Cover
                       double tolerancePx = kOutlineTolerancePx);
 
 struct OutlineDistances {
-  double hausdorffPx = 0;  // max over both directions of the distance from a point to the other
-  double meanPx = 0;       // mean of those distances over the points of both
+  double hausdorffPx = 0;      // max over both directions of the distance from a point to the other
+  double meanPx = 0;           // mean of those distances over the points of both
+  size_t unresolvedLoops = 0;  // closed loops of either outline thinner than resolvablePx
 };
 
 // Distances between two outlines: every located point of one inside its frame is measured to the
@@ -64,8 +65,13 @@ struct OutlineDistances {
 // With the outlines' geometry (`geometryA` of a, `geometryB` of b), a point further than 0.1 px
 // from the other outline and outside the other's geometry is measured to that geometry where it
 // is nearer, as compareSilhouettes does (coverage_distance.h).
+// A closed loop of either outline whose convex hull is thinner than `resolvablePx` (a pinhole
+// or a sliver that one sample caught, narrower than the reference can resolve: twice its
+// accuracyPx) is not measured, and counted in unresolvedLoops; it stays a target for the
+// other outline's points (a feature next to it is not missing).
 OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx,
                                  const CoverageDistanceQuery* geometryA = nullptr,
-                                 const CoverageDistanceQuery* geometryB = nullptr);
+                                 const CoverageDistanceQuery* geometryB = nullptr,
+                                 double resolvablePx = 0);
 
 }  // namespace limn::render::metrics

@@ -1,6 +1,7 @@
-// compareOutlines: see outline.h. Every located point of one outline is measured to the
-// nearest segment of the other through a bucket grid of segments, and where it is more than
-// kRemeasurePx away, to the other's geometry when the caller has it.
+// compareOutlines: see outline.h. Every located point of one outline, except those of closed
+// loops thinner than the caller can resolve, is measured to the nearest segment of the other
+// through a bucket grid of segments, and where it is more than kRemeasurePx away, to the other's
+// geometry when the caller has it.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -95,6 +96,81 @@ class SegmentIndex {
   std::vector<int> start_, entries_;
 };
 
+double cross(Vec2 o, Vec2 a, Vec2 b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+// The least width of the convex hull of `points`: over the hull's edges, the farthest hull
+// point from the edge's line, and the least of those. 0 for fewer than three points or points
+// on one line.
+double hullWidth(std::vector<Vec2> points) {
+  std::sort(points.begin(), points.end(),
+            [](Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  std::vector<Vec2> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {  // Andrew's monotone chain, lower then upper
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k > 0 ? k - 1 : 0);
+  if (hull.size() < 3) return 0;
+  double width = std::numeric_limits<double>::infinity();
+  for (size_t e = 0; e < hull.size(); ++e) {
+    const Vec2 a = hull[e], b = hull[(e + 1) % hull.size()];
+    const double length = std::hypot(b.x - a.x, b.y - a.y);
+    if (length == 0) continue;
+    double farthest = 0;
+    for (Vec2 p : hull) farthest = std::max(farthest, std::abs(cross(a, b, p)) / length);
+    width = std::min(width, farthest);
+  }
+  return width;
+}
+
+// The closed loops of `outline` (components whose every point joins exactly two segments) of at
+// most kMaxThinLoopPoints points whose convex hull is thinner than `resolvablePx`, as a mark per
+// point. The bound keeps the hull's quadratic width off the long outlines (a loop a few samples
+// long has a dozen points; one thinner than a sample follows a sample row or column, as a
+// slanted one breaks into single-sample loops).
+constexpr size_t kMaxThinLoopPoints = 64;
+
+std::vector<char> thinLoops(const Outline& outline, double resolvablePx, size_t& loops) {
+  const size_t n = outline.points.size();
+  std::vector<char> thin(n, 0);
+  if (resolvablePx <= 0) return thin;
+  std::vector<int> parent(n), degree(n, 0);
+  for (size_t k = 0; k < n; ++k) parent[k] = static_cast<int>(k);
+  auto root = [&](int k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  for (auto [a, b] : outline.segments) {
+    ++degree[a];
+    ++degree[b];
+    parent[root(a)] = root(b);
+  }
+  std::vector<std::vector<Vec2>> members(n);
+  std::vector<char> closed(n, 1);
+  for (size_t k = 0; k < n; ++k) {
+    const int r = root(static_cast<int>(k));
+    members[r].push_back(outline.points[k]);
+    if (degree[k] != 2) closed[r] = 0;
+  }
+  std::vector<char> dropRoot(n, 0);
+  for (size_t r = 0; r < n; ++r) {
+    if (members[r].size() < 3 || members[r].size() > kMaxThinLoopPoints || !closed[r]) continue;
+    if (hullWidth(members[r]) < resolvablePx) {
+      dropRoot[r] = 1;
+      ++loops;
+    }
+  }
+  for (size_t k = 0; k < n; ++k) thin[k] = dropRoot[root(static_cast<int>(k))];
+  return thin;
+}
+
 bool insideFrame(const Outline& o, Vec2 p) {
   return p.x >= 0.5 && p.y >= 0.5 && p.x <= o.frameWidth - 0.5 && p.y <= o.frameHeight - 0.5;
 }
@@ -103,13 +179,15 @@ bool insideFrame(const Outline& o, Vec2 p) {
 // when it can be (coverage_distance.h).
 constexpr double kRemeasurePx = 0.1;
 
-// Distances from every point of `from` inside its frame to the nearest item of `index`, lowered
-// to the distance to `toGeometry` (when given) where that is nearer.
-std::vector<double> directedDistances(const Outline& from, const SegmentIndex& index,
+// Distances from every point of `from` inside its frame and not marked in `unresolved` to the
+// nearest item of `index`, lowered to the distance to `toGeometry` (when given) where that is
+// nearer.
+std::vector<double> directedDistances(const Outline& from, const std::vector<char>& unresolved,
+                                      const SegmentIndex& index,
                                       const CoverageDistanceQuery* toGeometry) {
   std::vector<Vec2> measured;
-  for (Vec2 p : from.points) {
-    if (insideFrame(from, p)) measured.push_back(p);
+  for (size_t k = 0; k < from.points.size(); ++k) {
+    if (!unresolved[k] && insideFrame(from, from.points[k])) measured.push_back(from.points[k]);
   }
   std::vector<double> d(measured.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, d.size(), 256),
@@ -137,9 +215,17 @@ std::vector<double> directedDistances(const Outline& from, const SegmentIndex& i
 
 OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farPx,
                                  const CoverageDistanceQuery* geometryA,
-                                 const CoverageDistanceQuery* geometryB) {
-  if (a.empty() && b.empty()) return {};
-  if (a.empty() || b.empty()) return {farPx, farPx};
+                                 const CoverageDistanceQuery* geometryB, double resolvablePx) {
+  OutlineDistances result;
+  // Loops too thin to resolve are not measured, but stay targets: the other picture's feature
+  // next to one is not missing.
+  const std::vector<char> thinA = thinLoops(a, resolvablePx, result.unresolvedLoops);
+  const std::vector<char> thinB = thinLoops(b, resolvablePx, result.unresolvedLoops);
+  const auto resolved = [](const std::vector<char>& thin) {
+    return std::find(thin.begin(), thin.end(), 0) != thin.end();
+  };
+  if (!resolved(thinA) && !resolved(thinB)) return result;
+  if (a.empty() || b.empty()) return {farPx, farPx, result.unresolvedLoops};
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
   for (const Outline* o : {&a, &b}) {
     for (Vec2 p : o->points) {
@@ -150,9 +236,8 @@ OutlineDistances compareOutlines(const Outline& a, const Outline& b, double farP
     }
   }
   SegmentIndex indexA(a, x0, y0, x1, y1), indexB(b, x0, y0, x1, y1);
-  std::vector<double> ab = directedDistances(a, indexB, geometryB);
-  std::vector<double> ba = directedDistances(b, indexA, geometryA);
-  OutlineDistances result;
+  std::vector<double> ab = directedDistances(a, thinA, indexB, geometryB);
+  std::vector<double> ba = directedDistances(b, thinB, indexA, geometryA);
   double sum = 0;
   for (const std::vector<double>* d : {&ab, &ba}) {
     for (double v : *d) {

@@ -42,6 +42,7 @@ Metrics worstOf(const std::vector<Metrics>& views) {
         w.mismatchPx = std::max(w.mismatchPx, v.mismatchPx);
         worse(w.outlineHausdorffPx, v.outlineHausdorffPx);
         worse(w.outlineMeanPx, v.outlineMeanPx);
+        w.outlineUnresolvedLoops = std::max(w.outlineUnresolvedLoops, v.outlineUnresolvedLoops);
       });
   out.image = worstGroup(views, &Metrics::image, [](ColorMetrics& w, const ColorMetrics& v) {
     worse(w.rmse, v.rmse);

@@ -33,11 +33,14 @@ metrics::Metrics measureImages(const tessellate::TriangleMesh& approx, ImageSet&
   // The reference was hinted with this mask: its refined pixels hold all of its outline.
   metrics::Outline outline = oracle::locateMeshOutline(approx, camera, images.supersampledMask, S,
                                                        cancel, &reference.refinedPixels);
+  // A loop thinner than twice the reference's accuracy (its walls may each be that far off) is
+  // a feature it cannot tell from none: not measured, and counted.
   metrics::OutlineDistances d = metrics::compareOutlines(
       outline, reference.outline, std::hypot(camera.width(), camera.height()), &approxGeometry,
-      toReference);
+      toReference, 2 * reference.stats.accuracyPx);
   m.silhouette->outlineHausdorffPx = d.hausdorffPx;
   m.silhouette->outlineMeanPx = d.meanPx;
+  m.silhouette->outlineUnresolvedLoops = static_cast<long>(d.unresolvedLoops);
   spent.outlineMs = clock.lapMs();
   m.image = metrics::compareColor(images, refImages);
   // A surface without extent (every control point at one place: a valid mesh, drawn as a dot)

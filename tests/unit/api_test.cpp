@@ -876,7 +876,7 @@ render::pipeline::RenderResult handMadeResult() {
   reference.passes[render::pass::kMask] = render::Image(4, 3, 1, 1.0f);
 
   render::metrics::Metrics metrics;
-  metrics.silhouette = render::metrics::SilhouetteMetrics{0.31, 0.05, 0.9991, 212, 0.087, 0.012};
+  metrics.silhouette = render::metrics::SilhouetteMetrics{0.31, 0.05, 0.9991, 212, 0.087, 0.012, 3};
   metrics.image =
       render::metrics::ColorMetrics{0.004, std::numeric_limits<double>::infinity(), std::nullopt};
   metrics.geometry = render::metrics::GeometryMetrics{0.0002, std::nan(""), 0.00004};
@@ -935,6 +935,7 @@ TEST(RenderResponse, HasTheDesignShape) {
   EXPECT_EQ(m["silhouette"]["mismatchPx"].GetInt(), 212);
   EXPECT_DOUBLE_EQ(m["silhouette"]["outlineHausdorffPx"].GetDouble(), 0.087);
   EXPECT_DOUBLE_EQ(m["silhouette"]["outlineMeanPx"].GetDouble(), 0.012);
+  EXPECT_EQ(m["silhouette"]["outlineUnresolvedLoops"].GetInt(), 3);
   EXPECT_DOUBLE_EQ(m["image"]["rmse"].GetDouble(), 0.004);
   EXPECT_TRUE(m["image"]["psnr"].IsNull());  // infinity is not JSON
   EXPECT_TRUE(m["geometry"]["meanDist"].IsNull());

@@ -720,6 +720,53 @@ TEST(Outline, MissingPieceIsItsDistanceAway) {
   EXPECT_NEAR(d.hausdorffPx, 50 + 6 - 30, 0.01);  // the far side of the second disc
 }
 
+// A pinhole or sliver that only one sample caught, thinner than the reference can resolve
+// (resolvablePx, twice its accuracy), is not measured: it is as likely in either picture. A
+// thicker one, or a thin notch that is part of a larger outline, still counts by its reach.
+TEST(Outline, LoopsThinnerThanTheReferenceResolvesAreLeftOutAndCounted) {
+  const Shape disc = discAt(32, 32, 20);
+  // Samples at S = 4 lie at (i + 0.5) / 4: x = 20.125 and y = 30.125 is one.
+  auto withHole = [&](double width) -> Shape {
+    return [=](double x, double y) {
+      const bool hole = std::abs(x - 20.125) < width / 2 && y > 30.0 && y < 30.2;
+      return disc(x, y) && !hole;
+    };
+  };
+  const Outline whole = outlineOf(disc, 64, 4);
+  const Outline pinhole = outlineOf(withHole(0.02), 64, 4);
+  ASSERT_GT(pinhole.points.size(), whole.points.size());  // the hole was caught
+
+  OutlineDistances seen = compareOutlines(whole, pinhole, 90.0);
+  EXPECT_GT(seen.hausdorffPx, 5.0);  // the hole is far from the disc's rim
+  EXPECT_EQ(seen.unresolvedLoops, 0u);
+  OutlineDistances resolved = compareOutlines(whole, pinhole, 90.0, nullptr, nullptr, 0.05);
+  EXPECT_EQ(resolved.hausdorffPx, 0.0);
+  EXPECT_EQ(resolved.unresolvedLoops, 1u);
+
+  const Outline wider = outlineOf(withHole(0.1), 64, 4);
+  OutlineDistances kept = compareOutlines(whole, wider, 90.0, nullptr, nullptr, 0.05);
+  EXPECT_GT(kept.hausdorffPx, 5.0);
+  EXPECT_EQ(kept.unresolvedLoops, 0u);
+
+  // A sliver outside the disc, 0.02 px wide: the same, the other way round.
+  const Shape sliver = [&](double x, double y) {
+    return disc(x, y) || (std::abs(x - 60.125) < 0.01 && y > 10.0 && y < 10.2);
+  };
+  OutlineDistances island =
+      compareOutlines(outlineOf(sliver, 64, 4), whole, 90.0, nullptr, nullptr, 0.05);
+  EXPECT_EQ(island.hausdorffPx, 0.0);
+  EXPECT_EQ(island.unresolvedLoops, 1u);
+
+  // A notch as thin, cut 5 px in from the rim, is part of the disc's own outline: it counts.
+  const Shape notched = [&](double x, double y) {
+    return disc(x, y) && !(std::abs(x - 32.125) < 0.01 && y > 47.0);
+  };
+  OutlineDistances notch =
+      compareOutlines(whole, outlineOf(notched, 64, 4), 90.0, nullptr, nullptr, 0.05);
+  EXPECT_NEAR(notch.hausdorffPx, 5.0, 0.2);
+  EXPECT_EQ(notch.unresolvedLoops, 0u);
+}
+
 TEST(Outline, SaddleCellsFollowTheQuery) {
   // A checkerboard of 1 px squares seen at S = 1: every cell is a saddle, resolved by the query
   // at its centre; every crossing still ends up joined.
