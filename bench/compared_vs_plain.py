@@ -15,21 +15,12 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
-import sys
 import urllib.request
+
+from serve import start_server
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-
-
-def start_server(limn):
-    proc = subprocess.Popen([limn, "serve", "--listen", "127.0.0.1:0", "--workers", "1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    line = proc.stdout.readline()
-    if "listening on" not in line:
-        sys.exit("limn did not start: " + line)
-    return proc, line.split("listening on")[1].strip()
 
 
 def render(url, obj, reference):

@@ -29,6 +29,8 @@ import time
 import urllib.error
 import urllib.request
 
+from serve import start_server
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 TARGETS = {"adaptive:1": 0.5, "silhouette": 1.0, "patches:1": 1.0}
 
@@ -72,15 +74,6 @@ def random_view(rng, centre, radius, size):
         camera["projection"] = "orthographic"
         camera["orthoHeight"] = rng.uniform(2, 3) * radius
     return camera
-
-
-def start_server(limn):
-    proc = subprocess.Popen([limn, "serve", "--listen", "127.0.0.1:0", "--workers", "1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    line = proc.stdout.readline()
-    if "listening on" not in line:
-        sys.exit("limn did not start: " + line)
-    return proc, line.split("listening on")[1].strip()
 
 
 def post(url, body):

@@ -59,11 +59,15 @@ const char* endpointPath(Endpoint endpoint) {
   return "?";
 }
 
-void trimFreedMemoryAbove(size_t keepBytes) {
-  std::ifstream statm("/proc/self/statm");
+size_t residentBytesOf(const std::string& process) {
+  std::ifstream statm("/proc/" + process + "/statm");
   size_t pages = 0, resident = 0;
-  if (!(statm >> pages >> resident)) return;
-  if (resident * static_cast<size_t>(::sysconf(_SC_PAGESIZE)) > keepBytes) ::malloc_trim(0);
+  if (!(statm >> pages >> resident)) return 0;
+  return resident * static_cast<size_t>(::sysconf(_SC_PAGESIZE));
+}
+
+void trimFreedMemoryAbove(size_t keepBytes) {
+  if (residentBytesOf("self") > keepBytes) ::malloc_trim(0);
 }
 
 size_t keptWorkerMemoryBytes(size_t ceilingBytes) {

@@ -46,6 +46,9 @@ const char* endpointPath(Endpoint endpoint);
 // it). Throws what the Rasterizer constructor throws when no context can be made.
 std::unique_ptr<render::raster::Rasterizer> startRasterizer();
 
+// Resident memory of a process ("self" or a pid), from /proc; 0 when it cannot be read.
+size_t residentBytesOf(const std::string& process);
+
 // After a task, hands the memory the process freed back to the system (`malloc_trim`) when it
 // holds more than `keepBytes` resident; below that the next task reuses it. A 1024^2
 // comparison leaves about a gigabyte freed but resident in glibc's arenas, and faulting it in

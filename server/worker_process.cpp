@@ -10,7 +10,6 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstring>
-#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <stdexcept>
@@ -123,12 +122,7 @@ std::optional<WorkerProcess::Outcome> WorkerProcess::exitedWhileIdle() {
   return reap("", false);
 }
 
-size_t WorkerProcess::residentBytes() const {
-  std::ifstream statm("/proc/" + std::to_string(pid_) + "/statm");
-  size_t pages = 0, resident = 0;
-  if (!(statm >> pages >> resident)) return 0;
-  return resident * static_cast<size_t>(::sysconf(_SC_PAGESIZE));
-}
+size_t WorkerProcess::residentBytes() const { return residentBytesOf(std::to_string(pid_)); }
 
 WorkerProcess::Outcome WorkerProcess::reap(std::string why, bool kill) {
   exited_ = true;
