@@ -47,6 +47,16 @@ void mapNormals(tessellate::TriangleMesh& mesh, const normalmap::NormalAtlas& at
   mesh.normalMap = atlas.image();
 }
 
+// Whether every face of `surface` has a limit and lies on a closed piece wound outward, with no
+// displacement (which may fold the surface through itself).
+bool closedOutward(const subdiv::LimitSurface& surface) {
+  if (surface.displaced()) return false;
+  for (int f = 0; f < surface.faceCount(); ++f) {
+    if (!surface.hasLimit(f) || surface.hiddenSide(f) <= 0) return false;
+  }
+  return true;
+}
+
 // The methods that tessellate the surface directly (all but silhouette).
 tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobLimits& limits,
                                           const subdiv::LimitSurface& surface, const Camera& camera,
@@ -82,7 +92,10 @@ tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobL
       tessellate::AdaptiveOptions options;
       options.dicingRate = choice.params.dicingRate;
       options.maxTriangles = limits.maxTriangles;
-      return tessellate::tessellateAdaptive(surface, camera, options, cancel);
+      tessellate::TriangleMesh mesh =
+          tessellate::tessellateAdaptive(surface, camera, options, cancel);
+      mesh.closedOutward = closedOutward(surface);  // watertight by construction
+      return mesh;
     }
     case Method::Limit:
     case Method::Silhouette:

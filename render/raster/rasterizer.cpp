@@ -112,6 +112,15 @@ void placeOverlayTile(const std::vector<float>& color, const std::vector<unsigne
   }
 }
 
+// True when no vertex of `mesh` is behind the camera's near plane: a closed surface that the
+// near plane does not cut cannot hold the eye (nor, orthographic, any ray's start).
+bool inFrontOfNearPlane(const tessellate::TriangleMesh& mesh, const Camera& camera) {
+  for (const Vec3f& p : mesh.positions) {
+    if (camera.depthOf(Vec3(p.x, p.y, p.z)) <= camera.nearPlane()) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 struct Rasterizer::Impl {
@@ -130,6 +139,7 @@ struct Rasterizer::Impl {
   Framebuffer coverage{{GL_R8}, /*withDepth=*/false};
   int frameTileSize = 0;
   int coverageTileSize = 0;
+  bool backFacesHidden = false;  // of the mesh being drawn (see render())
   std::vector<float> readback;
   std::vector<float> colorReadback;  // kept while overlays are drawn over it
   std::vector<unsigned char> readbackBytes;
@@ -194,6 +204,13 @@ void Rasterizer::Impl::drawSurface(bool offsetSurface) {
   glCullFace(GL_BACK);
   glPolygonOffset(front, front);
   mesh.drawTriangles();
+  if (backFacesHidden) {
+    // A closed surface seen from outside: every back face is behind a front face. The second
+    // draw cost llvmpipe a quarter of a small request (bench/load_results.md).
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_CULL_FACE);
+    return;
+  }
   glCullFace(GL_FRONT);
   glPolygonOffset(front + kBackFaceOffset, front + kBackFaceOffset);
   mesh.drawTriangles();
@@ -421,6 +438,10 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample,
   const float zero[4] = {0, 0, 0, 0};
 
   glDisable(GL_DEPTH_TEST);  // any fragment at all means covered
+  if (backFacesHidden) {     // front faces cover all that back faces would
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  }
   solidProgram.use();
   solidProgram.setVec4("uColor", one);
   for (const Tile& tile : makeTiles(width, height, coverageTileSize)) {
@@ -436,6 +457,7 @@ void Rasterizer::Impl::renderCoverage(const Camera& camera, int supersample,
     placeTile(readbackBytes, 1, tile, covered,
               [](const unsigned char* from, uint8_t* to) { *to = *from > 127 ? 1 : 0; });
   }
+  glDisable(GL_CULL_FACE);
   out.supersampledMask = std::move(covered);
   out.supersample = supersample;
 }
@@ -487,6 +509,7 @@ ImageSet Rasterizer::render(const tessellate::TriangleMesh& mesh, const Camera& 
   if (!frame && passes.supersample == 0) return result;
 
   impl_->mesh.upload(mesh, mapped);
+  impl_->backFacesHidden = mesh.closedOutward && inFrontOfNearPlane(mesh, camera);
   if (mapped && frame) impl_->normalTexture.upload(*mesh.normalMap);
   if (!overlays.empty()) impl_->overlayLines.upload(overlays);
   PassSelection drawn = passes;

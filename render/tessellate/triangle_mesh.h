@@ -43,6 +43,11 @@ struct TriangleMesh {
   // shading's front albedo. Back faces keep the back albedo either way.
   std::vector<Vec3f> albedo;
 
+  // Every piece closed and wound outward, without cracks (set for adaptive meshes of such a
+  // surface, undisplaced): from an eye outside it, each back face lies behind a front face, so
+  // the rasteriser need not draw back faces while the whole mesh is in front of the near plane.
+  bool closedOutward = false;
+
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size(); }
 };

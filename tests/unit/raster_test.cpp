@@ -603,6 +603,32 @@ TEST_F(RasterTest, SphereOfAHundredThousandTriangles) {
   EXPECT_NEAR(bigArea / 16, area, 0.002 * area);
 }
 
+// A closed surface wound outward needs no back faces from outside (TriangleMesh::closedOutward):
+// every pass comes out the same without them. With the eye inside (the near plane cuts it) the
+// back faces are what is seen, and they are still drawn.
+TEST_F(RasterTest, AClosedSurfaceSeenFromOutsideIsTheSameWithoutItsBackFaces) {
+  TriangleMesh drawnBoth = sphere(1.0, 40, 56);
+  TriangleMesh closed = drawnBoth;
+  closed.closedOutward = true;
+  PassSelection passes = allPasses(4);
+  passes.antialias = 4;
+  const Camera outside({0.3, 0.2, 4}, {0, 0, 0}, {0, 1, 0}, 40.0, Projection::Perspective, 2.0, 160,
+                       120, 1.0, 10.0);
+  const Camera inside({0, 0, 0.2}, {0, 0, 1}, {0, 1, 0}, 60.0, Projection::Perspective, 2.0, 160,
+                      120, 0.05, 10.0);
+  for (const Camera& camera : {outside, inside}) {
+    ImageSet both = rasterizer().render(drawnBoth, camera, passes, Shading::Smooth);
+    ImageSet front = rasterizer().render(closed, camera, passes, Shading::Smooth);
+    for (const char* name : {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal}) {
+      EXPECT_EQ(both.passes[name].pixels, front.passes[name].pixels) << name;
+    }
+    EXPECT_EQ(both.supersampledMask.covered, front.supersampledMask.covered);
+  }
+  // Inside, only back faces face the eye: the picture is all back albedo, not background.
+  ImageSet seenFromInside = rasterizer().render(closed, inside, passes, Shading::Smooth);
+  for (float v : seenFromInside.passes[pass::kMask].pixels) ASSERT_EQ(v, 1.0f);
+}
+
 TEST_F(RasterTest, MillionsOfTriangles) {
   // A 1000 x 1000 grid of quads: 2 million triangles covering a square that fills the frame.
   const int n = 1000;
