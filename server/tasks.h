@@ -53,7 +53,7 @@ size_t residentBytesOf(const std::string& process);
 // holds more than `keepBytes` resident; below that the next task reuses it. A 1024^2
 // comparison leaves about a gigabyte freed but resident in glibc's arenas, and faulting it in
 // again is most of a request's time in a VM: the pawn's adaptive tessellation took 243 ms
-// after a trim against 39 ms without one (bench/load_results.md).
+// after a trim against 39 ms without one (docs/engine.md, "Limits").
 void trimFreedMemoryAbove(size_t keepBytes);
 
 // What a render worker keeps resident between tasks before it trims: a quarter of its memory

@@ -152,20 +152,28 @@ std::vector<char> thinLoops(const Outline& outline, double resolvablePx, size_t&
     ++degree[b];
     parent[root(a)] = root(b);
   }
-  std::vector<std::vector<Vec2>> members(n);
+  // Per component: its size, and whether every point joins two segments.
+  std::vector<size_t> size(n, 0);
   std::vector<char> closed(n, 1);
   for (size_t k = 0; k < n; ++k) {
     const int r = root(static_cast<int>(k));
-    members[r].push_back(outline.points[k]);
+    ++size[r];
     if (degree[k] != 2) closed[r] = 0;
+  }
+  auto candidate = [&](int r) {
+    return closed[r] && size[r] >= 3 && size[r] <= kMaxThinLoopPoints;
+  };
+  // The points of the small closed loops only (the long outlines are not copied).
+  std::vector<std::vector<Vec2>> members(n);
+  for (size_t k = 0; k < n; ++k) {
+    const int r = root(static_cast<int>(k));
+    if (candidate(r)) members[r].push_back(outline.points[k]);
   }
   std::vector<char> dropRoot(n, 0);
   for (size_t r = 0; r < n; ++r) {
-    if (members[r].size() < 3 || members[r].size() > kMaxThinLoopPoints || !closed[r]) continue;
-    if (hullWidth(members[r]) < resolvablePx) {
-      dropRoot[r] = 1;
-      ++loops;
-    }
+    if (members[r].empty() || hullWidth(members[r]) >= resolvablePx) continue;
+    dropRoot[r] = 1;
+    ++loops;
   }
   for (size_t k = 0; k < n; ++k) thin[k] = dropRoot[root(static_cast<int>(k))];
   return thin;
