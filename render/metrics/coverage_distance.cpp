@@ -16,6 +16,8 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <tuple>
+#include <utility>
 
 namespace limn::render::metrics {
 
@@ -186,6 +188,9 @@ struct ProjectedMesh {
   std::once_flag once;
   std::vector<Vec2> projected;
   std::vector<char> inFront;  // in front of the near plane
+  // Some triangle reaches behind it: left out, it could leave a point it covers looking
+  // uncovered, so gaps are not searched for (coverage_distance.h).
+  bool partlyBehind = false;
   TriangleBuckets buckets;
 
   void project() {
@@ -202,8 +207,165 @@ struct ProjectedMesh {
                         }
                       });
     buckets.build(mesh, projected, inFront);
+    for (size_t i = 0; i < mesh.indices.size() && !partlyBehind; ++i) {
+      partlyBehind = !inFront[mesh.indices[i]];
+    }
   }
 };
+
+// The search for gaps narrower than the samples around one covered point.
+//
+// The coverage's edge lies on the triangles' edges, and only on those that are not between two
+// triangles on either side of them: a mesh border, or a fold where both triangles lie on one
+// side (a contour). Each such edge, moved a hair off its triangles, is clipped against every
+// other triangle near the point; what no triangle covers is uncovered, and its nearest point
+// is a point of the coverage's edge.
+class GapSearch {
+ public:
+  // The narrowest gap looked for (output px).
+  static constexpr double kGapPx = 1e-3;
+
+  GapSearch(const ProjectedMesh& projection, Vec2 p, double radius) : p_(p) {
+    const tessellate::TriangleMesh& mesh = projection.mesh;
+    for (uint32_t t :
+         projection.buckets.near(p.x - radius, p.y - radius, p.x + radius, p.y + radius)) {
+      const uint32_t* c = &mesh.indices[3 * size_t{t}];
+      const Vec2 &a = projection.projected[c[0]], &b = projection.projected[c[1]],
+                 &d = projection.projected[c[2]];
+      if (pointTriangleDistance(p, a, b, d) < radius) triangles_.push_back({a, b, d});
+    }
+  }
+
+  // The distance from the point to the nearest point no triangle covers, when below `bound`;
+  // else `bound`.
+  double nearestUncovered(double bound) const {
+    double best = bound;
+    for (const BorderEdge& e : borderEdges()) {
+      if (pointSegmentDistance(p_, e.a, e.b) >= best) continue;
+      for (double side : {-1.0, 1.0}) {
+        if (e.side != 0 && side != e.side) continue;
+        best = std::min(best, nearestUncoveredOn(e, side));
+      }
+    }
+    return best;
+  }
+
+ private:
+  struct Triangle {
+    Vec2 a, b, c;
+  };
+  // An edge that can bound the coverage, and the side away from its triangles (+1 left of a->b,
+  // -1 right; 0: both sides are searched, for edges of three or more triangles or flat ones).
+  struct BorderEdge {
+    Vec2 a, b;
+    double side;
+  };
+
+  static bool before(const Vec2& u, const Vec2& v) {
+    return u.x < v.x || (u.x == v.x && u.y < v.y);
+  }
+
+  // The triangles' edges that are not shared by exactly two triangles on opposite sides. Edges
+  // are matched by their endpoints' positions, so that meshes which repeat vertices along patch
+  // seams (at the same positions: crack-free) are matched across them.
+  std::vector<BorderEdge> borderEdges() const {
+    struct HalfEdge {
+      Vec2 a, b;    // a before b
+      double side;  // sign of the triangle's third corner, left of a->b positive
+    };
+    std::vector<HalfEdge> halves;
+    halves.reserve(3 * triangles_.size());
+    for (const Triangle& t : triangles_) {
+      const Vec2 corners[3] = {t.a, t.b, t.c};
+      for (int k = 0; k < 3; ++k) {
+        Vec2 u = corners[k], v = corners[(k + 1) % 3];
+        if (before(v, u)) std::swap(u, v);
+        const double area = cross(u, v, corners[(k + 2) % 3]);
+        halves.push_back({u, v, area > 0 ? 1.0 : area < 0 ? -1.0 : 0.0});
+      }
+    }
+    auto key = [](const HalfEdge& h) { return std::tie(h.a.x, h.a.y, h.b.x, h.b.y); };
+    std::sort(halves.begin(), halves.end(),
+              [&](const HalfEdge& l, const HalfEdge& r) { return key(l) < key(r); });
+    std::vector<BorderEdge> edges;
+    for (size_t i = 0; i < halves.size();) {
+      size_t j = i + 1;
+      while (j < halves.size() && key(halves[j]) == key(halves[i])) ++j;
+      const HalfEdge& h = halves[i];
+      if (j - i == 1 && h.side != 0) {
+        edges.push_back({h.a, h.b, -h.side});
+      } else if (j - i == 2 && h.side != 0 && h.side == halves[i + 1].side) {
+        edges.push_back({h.a, h.b, -h.side});  // a fold: both triangles on one side
+      } else if (j - i != 2 || h.side * halves[i + 1].side >= 0) {
+        edges.push_back({h.a, h.b, 0});
+      }
+      i = j;
+    }
+    return edges;
+  }
+
+  // The distance from the point to the nearest point of edge `e`, moved kGapPx to `side`, that
+  // no triangle covers (infinity when every point is covered). Covered runs less than kGapPx
+  // apart are one: the positions are floats, and a gap that narrow is rounding, not surface.
+  double nearestUncoveredOn(const BorderEdge& e, double side) const {
+    const double dx = e.b.x - e.a.x, dy = e.b.y - e.a.y;
+    const double length = std::hypot(dx, dy);
+    if (length == 0) return std::numeric_limits<double>::infinity();
+    // The left normal of a->b is (-dy, dx).
+    const Vec2 a{e.a.x - side * kGapPx * dy / length, e.a.y + side * kGapPx * dx / length};
+    const Vec2 b{a.x + dx, a.y + dy};
+    std::vector<std::pair<double, double>> covered;
+    for (const Triangle& t : triangles_) {
+      double t0 = 0, t1 = 1;
+      if (clipToTriangle(a, b, t, t0, t1)) covered.push_back({t0, t1});
+    }
+    std::sort(covered.begin(), covered.end());
+    // The foot of the point on the edge, and the covered run [lo, hi] holding it, if any.
+    const double foot =
+        std::clamp(((p_.x - a.x) * dx + (p_.y - a.y) * dy) / (length * length), 0.0, 1.0);
+    double lo = 0, hi = -1;
+    for (auto [t0, t1] : covered) {
+      if (t0 > hi + kGapPx / length) {  // a new run
+        if (lo <= foot && foot <= hi) break;
+        lo = t0;
+      }
+      hi = std::max(hi, t1);
+    }
+    const bool inside = lo <= foot && foot <= hi;
+    auto at = [&](double t) { return std::hypot(p_.x - (a.x + t * dx), p_.y - (a.y + t * dy)); };
+    if (!inside) return at(foot);
+    double best = std::numeric_limits<double>::infinity();
+    if (lo > 0) best = std::min(best, at(lo));
+    if (hi < 1) best = std::min(best, at(hi));
+    return best;
+  }
+
+  // Clips the parameters [t0, t1] of segment a->b to the closed triangle; false when empty.
+  static bool clipToTriangle(const Vec2& a, const Vec2& b, const Triangle& t, double& t0,
+                             double& t1) {
+    const double area = cross(t.a, t.b, t.c);
+    if (area == 0) return false;
+    const double s = area > 0 ? 1 : -1;
+    const Vec2 corners[3] = {t.a, t.b, t.c};
+    for (int k = 0; k < 3; ++k) {
+      // Inside edge k where s * cross(u, v, x) >= 0, linear along the segment.
+      const double fa = s * cross(corners[k], corners[(k + 1) % 3], a);
+      const double fb = s * cross(corners[k], corners[(k + 1) % 3], b);
+      if (fa < 0 && fb < 0) return false;
+      if (fa < 0) t0 = std::max(t0, fa / (fa - fb));
+      if (fb < 0) t1 = std::min(t1, fa / (fa - fb));
+      if (t0 > t1) return false;
+    }
+    return true;
+  }
+
+  Vec2 p_;
+  std::vector<Triangle> triangles_;
+};
+
+// Gaps narrower than the samples are searched for only this far from a point: a search gathers
+// every triangle within it.
+constexpr double kMaxGapSearchPx = 8;
 
 void lowerToMeshDistances(ProjectedMesh& projection, const std::vector<Vec2>& points,
                           std::vector<double>& distances) {
@@ -252,6 +414,7 @@ void lowerToMeshDistances(ProjectedMesh& projection, const std::vector<Vec2>& po
                       }
                     });
   cancel.check();
+  std::vector<size_t> coveredPoints;
   for (size_t k = 0; k < points.size(); ++k) {
     double lowest = distances[k];
     bool covered = false;
@@ -259,8 +422,26 @@ void lowerToMeshDistances(ProjectedMesh& projection, const std::vector<Vec2>& po
       lowest = std::min(lowest, n.distance[k]);
       covered = covered || n.covered[k];
     }
-    if (!covered) distances[k] = lowest;
+    if (!covered) {
+      distances[k] = lowest;
+    } else if (!projection.partlyBehind) {
+      coveredPoints.push_back(k);
+    }
   }
+  // A covered point's sampled distance is to the other outline's samples, which miss a gap or
+  // slit narrower than they are: measure it to the nearest point the triangles leave uncovered.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, coveredPoints.size(), 1),
+                    [&](const tbb::blocked_range<size_t>& range) {
+                      for (size_t i = range.begin(); i < range.end(); ++i) {
+                        if (cancel.expired()) return;
+                        const size_t k = coveredPoints[i];
+                        const double radius = std::min(distances[k], kMaxGapSearchPx);
+                        const double gap =
+                            GapSearch(projection, points[k], radius).nearestUncovered(radius);
+                        if (gap < radius) distances[k] = gap;
+                      }
+                    });
+  cancel.check();
 }
 
 }  // namespace
@@ -286,8 +467,8 @@ double pointTriangleDistance(const Vec2& p, const Vec2& a, const Vec2& b, const 
 
 CoverageDistanceQuery meshCoverageDistance(const tessellate::TriangleMesh& mesh,
                                            const Camera& camera, const CancelToken& cancel) {
-  auto projection =
-      std::shared_ptr<ProjectedMesh>(new ProjectedMesh{mesh, camera, cancel, {}, {}, {}});
+  auto projection = std::shared_ptr<ProjectedMesh>(
+      new ProjectedMesh{mesh, camera, cancel, {}, {}, {}, false, {}});
   return [projection](const std::vector<Vec2>& points, std::vector<double>& distances) {
     lowerToMeshDistances(*projection, points, distances);
   };

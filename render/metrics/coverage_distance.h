@@ -9,7 +9,10 @@
 // a gap of pixels (3.4 px on a cube with infinitely sharp corners at 512^2, S = 4; the gap
 // changes with S, which the geometry does not). Measuring from a point outside the other shape
 // to that shape's triangles gives the distance the metric means: to the nearest point the
-// other rendering covers.
+// other rendering covers. The same holds inside out: a slit or gap narrower than the spacing
+// (two parts that nearly touch, seen at a grazing angle) has no sample in it, so from a point
+// the other shape covers the distance is measured to the nearest point its triangles leave
+// uncovered.
 #pragma once
 
 #include <functional>
@@ -23,10 +26,12 @@
 namespace limn::render::metrics {
 
 // Image-plane points in output pixels (as outline.h). On entry distances[k] is an upper bound
-// for points[k] (the distance the samples gave); it is lowered to the distance from points[k]
-// to the nearest covered point where that is smaller and points[k] itself is not covered.
-// Points the geometry covers keep their bound: there the distance wanted is to the edge of the
-// coverage, which the samples measure. The query may run on several threads.
+// for points[k] (the distance the samples gave); it is lowered, where that is smaller, to the
+// distance from points[k] to the nearest covered point when points[k] is not covered, and to
+// the nearest uncovered point (the coverage's edge) when it is. Uncovered points are searched
+// for at most 8 px away and a thousandth of a pixel off the triangles' edges (narrower gaps are
+// the rounding of float positions along seams), and not at all when some triangle reaches
+// behind the near plane (left out, it could seem a gap). The query may run on several threads.
 using CoverageDistanceQuery =
     std::function<void(const std::vector<Vec2>& points, std::vector<double>& distances)>;
 

@@ -182,6 +182,20 @@ TEST(UnresolvedLoops, APinholeThinnerThanTheReferenceResolvesIsNotAnOutline) {
   EXPECT_GE(silhouette["outlineUnresolvedLoops"].GetInt(), 0);
 }
 
+// Slits narrower than the samples: the octopus from above at 1024^2, where two arms nearly
+// touch and leave a slit a few hundredths of a pixel wide at a grazing angle. Where no sample
+// of the reference's mask fell into the slit, the approximation's dash of it read as far as
+// the reference's nearest sampled outline: 1.13 px for adaptive (and patches). Points one
+// rendering covers are now measured to the nearest point its triangles leave uncovered
+// (docs/engine.md, "Features narrower than the samples"): 0.08 px.
+TEST(NarrowSlits, ASlitBetweenTwoArmsIsMeasuredToTheOtherRenderingsSlit) {
+  expectOutlineWithin(
+      meshJson(corpusDir() / "octopus.obj"), R"("method": "adaptive", "params": {"dicingRate": 1})",
+      R"({"eye": [1.5872826, 4.0455930, 6.5402178], "target": [-0.000342, 0.647758, -0.1917245],
+          "up": [0, 1, 0], "fovYDeg": 25.7322464, "width": 1024, "height": 1024})",
+      0.5);
+}
+
 // N-gon fans next to poles: the fish's decagon caps (Catmull-Clark, a flattened tube) and the
 // flower's valence-12 poles and hexagon cap (Loop), from views that see the caps and poles at
 // the outline. One comparison per view measures every method against one reference.
