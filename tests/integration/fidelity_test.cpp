@@ -147,6 +147,18 @@ TEST(OpenShell, AThinWallsInnerChordsDoNotPokeThroughTheOuterWall) {
       1.0);
 }
 
+// The same fold from another view at 1024^2: the gap between the front sheets is covered only
+// by fold triangles a little wider than 1 px, which the rule above (a corner on the contour,
+// under 1 px wide) culled: a hole 0.1 x 1.5 px inside the body, 15.4 px from the outline.
+// Hidden triangles of a thin fold's face that lie within 1 px of its contour curves are kept.
+TEST(ThinFold, AFoldsWiderTrianglesInTheBandAreKept) {
+  expectOutlineWithin(
+      meshJson(corpusDir() / "cactus.obj"), R"("method": "silhouette")",
+      R"({"eye": [0.8076234, 2.2541790, 2.1655825], "target": [0, 0.6, 0], "up": [0, 1, 0],
+          "fovYDeg": 20.9991281, "width": 1024, "height": 1024})",
+      1.0);
+}
+
 // A fan of chords in a contour face: the bottle's neck from the side. Below the contour curve a
 // face's region was ear-clipped into a fan from one corner to the curve's samples; the fan's
 // long chords cut across the neck's flare and poked through the outer wall, more than the
