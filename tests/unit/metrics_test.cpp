@@ -832,7 +832,7 @@ TEST(CoverageDistance, LowersBoundsToTheNearestCoveredPointOnly) {
   query(points, distances);
   EXPECT_NEAR(distances[0], 0.495, 1e-6);  // beside the needle (0.005 px half-wide there)
   EXPECT_NEAR(distances[1], 3.0, 1e-3);    // past its tip: exactly the bound
-  EXPECT_EQ(distances[2], 3.0);            // covered: the bound stays
+  EXPECT_EQ(distances[2], 3.0);            // covered, its edge 5 px off: the bound stays
   EXPECT_NEAR(distances[3], 3.0, 1e-3);    // 3 px above the square
   EXPECT_EQ(distances[4], 1.5);            // nothing within the bound
 }
