@@ -9,10 +9,6 @@ namespace limn::render::silhouette {
 
 namespace {
 
-double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
 // True when p lies inside or on triangle abc (counter-clockwise), with tolerance `eps`.
 bool inTriangle(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c, double eps) {
   return cross2(a, b, p) >= -eps && cross2(b, c, p) >= -eps && cross2(c, a, p) >= -eps;

@@ -225,39 +225,86 @@ size_t cullHidden(const FaceDomains& domains, const Camera& camera, int face, Fa
   return before - piece.triangles.size();
 }
 
-// The boundary of a face of more than four sides (its corners and edge points, counter-
-// clockwise in (u, v)), triangulated where it lies: ear-clipped in the plane that fits it best
-// (Newell's normal), with the triangles' corners in the boundary's order as a fan's are. The
-// face's domain is a regular polygon, convex, and so is any triangulation made in it, but the
-// face need not be: the flat cap of a gear is a concave 64-gon, and a triangulation of its
-// domain drew chords from one tooth to the next across the gaps between them (the held-out
-// workshop from below, 17.6 px outside the outline).
-std::vector<std::array<int, 3>> clipBoundaryInSpace(const std::vector<FacePoint>& boundary) {
-  const int n = static_cast<int>(boundary.size());
+// The boundary's corners and edge points in the plane that fits them best (Newell's normal),
+// with axes whose cross product is that normal: a boundary counter-clockwise about it is
+// counter-clockwise in the plane. Empty when there is no such plane (a degenerate boundary).
+std::vector<Vec2> boundaryInBestPlane(const std::vector<FacePoint>& boundary) {
+  const size_t n = boundary.size();
   Vec3 normal{0, 0, 0};
-  for (int i = 0; i < n; ++i) {
+  for (size_t i = 0; i < n; ++i) {
     const Vec3& a = boundary[i].position;
     const Vec3& b = boundary[(i + 1) % n].position;
     normal += Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
   }
-  std::vector<std::array<int, 3>> triangles;
-  if (!(length(normal) > 0)) {  // no plane to clip in
-    for (int k = 1; k + 1 < n; ++k) triangles.push_back({0, k, k + 1});
-    return triangles;
-  }
+  if (!(length(normal) > 0)) return {};
   normal = normalize(normal);
-  // Axes with x cross y = the normal: the boundary, counter-clockwise about its Newell normal,
-  // is counter-clockwise in the plane, as earClip wants it.
   const Vec3 helper = std::abs(normal.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
   const Vec3 xAxis = normalize(cross(helper, normal)), yAxis = cross(normal, xAxis);
   std::vector<Vec2> planar(n);
-  std::vector<int> polygon(n);
-  for (int i = 0; i < n; ++i) {
+  for (size_t i = 0; i < n; ++i) {
     planar[i] = {dot(boundary[i].position, xAxis), dot(boundary[i].position, yAxis)};
-    polygon[i] = i;
   }
+  return planar;
+}
+
+// Whether two segments cross at a point inside both (touching ends do not count).
+bool segmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  const double abc = cross2(a, b, c), abd = cross2(a, b, d);
+  const double cda = cross2(c, d, a), cdb = cross2(c, d, b);
+  return ((abc > 0 && abd < 0) || (abc < 0 && abd > 0)) &&
+         ((cda > 0 && cdb < 0) || (cda < 0 && cdb > 0));
+}
+
+// Whether the boundary, laid in its best plane, is a simple polygon that turns back (a reflex
+// corner more than kReflexTurn off straight). Such a face is concave where it lies, and a
+// triangulation of its (u, v) domain, convex, spans the concave stretch with chords that leave
+// the face: the flat cap of a gear, cut into quads, whose rim turns back at every tooth root,
+// drew a chord 17 px long a few pixels outside the rim (the held-out gear, 3.19 px). A boundary
+// that folds over itself in the plane (a face wrapping most of a thin tube) is not clipped there.
+bool concaveInBestPlane(const std::vector<Vec2>& planar) {
+  constexpr double kReflexTurn = 1e-3;  // sine of the turn: rounding on straight runs is not one
+  const size_t n = planar.size();
+  double area = 0;
+  for (size_t i = 0; i < n; ++i) area += cross2({0, 0}, planar[i], planar[(i + 1) % n]);
+  if (!(area > 0)) return false;  // no plane (Newell's normal makes the area positive otherwise)
+  bool reflex = false;
+  for (size_t i = 0; i < n && !reflex; ++i) {
+    const Vec2 &a = planar[(i + n - 1) % n], &b = planar[i], &c = planar[(i + 1) % n];
+    const double ab = std::hypot(b.x - a.x, b.y - a.y), bc = std::hypot(c.x - b.x, c.y - b.y);
+    reflex = cross2(a, b, c) < -kReflexTurn * ab * bc;
+  }
+  if (!reflex) return false;
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours around the wrap
+      if (segmentsCross(planar[i], planar[i + 1], planar[j], planar[(j + 1) % n])) return false;
+    }
+  }
+  return true;
+}
+
+// The boundary of a face (its corners and edge points, counter-clockwise in (u, v)),
+// triangulated where it lies: ear-clipped in its best plane, with the triangles' corners in the
+// boundary's order as a fan's are. The face's domain is a regular polygon, convex, and so is any
+// triangulation made in it, but the face need not be: the flat cap of a gear is a concave
+// 64-gon, and a triangulation of its domain drew chords from one tooth to the next across the
+// gaps between them (the held-out workshop from below, 17.6 px outside the outline).
+std::vector<std::array<int, 3>> clipBoundaryInSpace(const std::vector<FacePoint>& boundary,
+                                                    const std::vector<Vec2>& planar) {
+  const int n = static_cast<int>(boundary.size());
+  std::vector<std::array<int, 3>> triangles;
+  if (planar.empty()) {  // no plane to clip in
+    for (int k = 1; k + 1 < n; ++k) triangles.push_back({0, k, k + 1});
+    return triangles;
+  }
+  std::vector<int> polygon(n);
+  for (int i = 0; i < n; ++i) polygon[i] = i;
   earClip(planar, polygon, triangles);
   return triangles;
+}
+
+std::vector<std::array<int, 3>> clipBoundaryInSpace(const std::vector<FacePoint>& boundary) {
+  return clipBoundaryInSpace(boundary, boundaryInBestPlane(boundary));
 }
 
 FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const ContourSearch& search,
@@ -308,9 +355,12 @@ FacePiece buildFace(const FaceDomains& domains, const Camera& camera, const Cont
   std::vector<Vec2> uv;
   uv.reserve(piece.points.size());
   for (const FacePoint& p : piece.points) uv.push_back(p.uv);
-  // Contour curves cut the face in its domain; a face without any is clipped where it lies.
-  piece.triangles = paths.empty() && corners > 4
-                        ? clipBoundaryInSpace(boundary.points)
+  // Contour curves cut the face in its domain; a face without any is clipped where it lies
+  // when it has more than four corners or is concave there.
+  const std::vector<Vec2> planar =
+      paths.empty() ? boundaryInBestPlane(boundary.points) : std::vector<Vec2>{};
+  piece.triangles = paths.empty() && (corners > 4 || concaveInBestPlane(planar))
+                        ? clipBoundaryInSpace(boundary.points, planar)
                         : triangulateFace(uv, static_cast<int>(boundary.points.size()), paths);
   // Only exact curves lie on the surface; a chord ending at a pn sample (off the surface) would
   // never come within tolerance, so pn faces keep their ear-clipped triangles.
