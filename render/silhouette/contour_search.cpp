@@ -226,6 +226,22 @@ double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b) {
   return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
 }
 
+// The length in the image of an outline edge's limit curve, as a polyline through `pieces` + 1
+// uniform points: a short edge can bulge far past the chord between its ends (a leaf's rounded
+// lobe at its tip, a boundary edge 1.7 px end to end whose curve stands 1.4 px off that chord).
+double projectedLengthPx(const FaceDomains& domains, const Camera& camera, int face, int edge,
+                         int pieces) {
+  double length = 0;
+  Vec3 last = camera.project(domains.position(face, edgeUV(domains, face, edge, 0.0)));
+  for (int i = 1; i <= pieces; ++i) {
+    const double t = static_cast<double>(i) / pieces;
+    const Vec3 next = camera.project(domains.position(face, edgeUV(domains, face, edge, t)));
+    length += std::hypot(next.x - last.x, next.y - last.y);
+    last = next;
+  }
+  return length;
+}
+
 // The fewest uniform segments along an outline edge's limit curve whose chords stay within
 // `tolerancePx` of it in the image, judged at `dense` uniform samples (the most it returns).
 // A straight crease (a shelf's board, a box's edge) needs no interior point at all, where one
@@ -405,9 +421,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
       const bool outline = validFaces == 1 || (crease && (sideSignsDiffer || !found.empty()));
       if (outline) {
         ++outlines;
-        const Vec3 a = camera.project(limitPositions[ends[0]]);
-        const Vec3 b = camera.project(limitPositions[ends[1]]);
-        double pixels = std::hypot(a.x - b.x, a.y - b.y);
+        const double pixels = projectedLengthPx(domains, camera, owner, static_cast<int>(e), 8);
         int segments = std::clamp(static_cast<int>(std::ceil(pixels / options.pixelsPerSample)), 1,
                                   std::max(1, options.outlineSamples + 1));
         if (segments > 1) {

@@ -39,9 +39,10 @@ struct SearchOptions {
   int edgeSamples = 4;  // intervals sampled on an edge the bound cannot clear
   // Outline edges (boundaries, and infinitely sharp creases seen front on one side and back on
   // the other) are part of the outline: their limit curve is sampled about every
-  // `pixelsPerSample` pixels, at most `outlineSamples` per edge, and they get the fewest uniform
-  // points whose chords stay within `outlineTolerancePx` of those samples in the image (none on
-  // a straight edge).
+  // `pixelsPerSample` pixels of its length in the image (not of the chord between its ends,
+  // which a short bulging edge far exceeds), at most `outlineSamples` per edge, and they get the
+  // fewest uniform points whose chords stay within `outlineTolerancePx` of those samples in the
+  // image (none on a straight edge).
   double pixelsPerSample = 2.0;
   int outlineSamples = 32;
   double outlineTolerancePx = 0.01;

@@ -21,6 +21,7 @@ class CrossLineSolver {
   CrossLineSolver(const FaceDomains& domains, const Camera& camera, int face)
       : domains_(domains), camera_(camera), face_(face) {}
 
+  int face() const { return face_; }
   bool inside(const Vec2& uv) const { return domains_.contains(face_, uv); }
 
   double g(const Vec2& uv) const {
@@ -100,9 +101,59 @@ class CrossLineSolver {
   int face_;
 };
 
+// Image distance from p to the segment [a, b].
+double distanceToChordPx(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
+  const double t =
+      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+// Samples spaced evenly in (u, v) bunch where the curve turns fastest in the image least: at a
+// tip (a slat's rounded end, a leaf's point, a leg's tapering end) two samples a few pixels
+// apart cut the turn with a chord a pixel inside it (the held-out fence's slat end, 2.16 px),
+// and a curve whose ends lie within 2 px had no sample at all (a leg's end cap, its contour
+// round the tip 1.9 px across and 3.3 px long, cut straight across). Between two samples found
+// on the curve (or the curve's ends), the curve's point halfway in (u, v) is found across
+// their line; where it lies more than options.maxSagPx from their chord in the image it is
+// added, and both halves are checked again, up to options.curveSamples samples in all. In a
+// face with other curves, a point found farther off than the chord is long may lie on one of
+// them (a hairpin's other leg), which the curve must not cross, and is not added; `alone`
+// says there is no other.
+void refineSagging(const FaceDomains& domains, const Camera& camera, const CrossLineSolver& solver,
+                   const FacePoint& a, const FacePoint& b, const CurveOptions& options, bool alone,
+                   std::vector<bool>& resolved, std::vector<FacePoint>& samples) {
+  auto pointAt = [&](size_t i) -> const FacePoint& {  // 0: a, samples.size() + 1: b
+    return i == 0 ? a : i == samples.size() + 1 ? b : samples[i - 1];
+  };
+  auto onCurve = [&](size_t i) { return i == 0 || i == samples.size() + 1 || resolved[i - 1]; };
+  for (size_t i = 0;
+       i <= samples.size() && static_cast<int>(samples.size()) < options.curveSamples;) {
+    const FacePoint &p = pointAt(i), &q = pointAt(i + 1);
+    const Vec2 along{q.uv.x - p.uv.x, q.uv.y - p.uv.y};
+    const double span = std::hypot(along.x, along.y);
+    const Vec3 pi = camera.project(p.position), qi = camera.project(q.position);
+    const double chordPx = std::hypot(qi.x - pi.x, qi.y - pi.y);
+    Vec2 uv = lerp(p.uv, q.uv, 0.5);
+    const bool split = onCurve(i) && onCurve(i + 1) && span > 1e-6 && chordPx > options.maxSagPx &&
+                       solver.solve(uv, {-along.y / span, along.x / span}, 0.02 * span, &uv);
+    if (split) {
+      const subdiv::LimitSample s = domains.evaluate(solver.face(), uv);
+      const double sag = distanceToChordPx(camera.project(s.position), pi, qi);
+      if (sag > options.maxSagPx && (alone || sag < chordPx)) {
+        samples.insert(samples.begin() + static_cast<long>(i), {uv, s.position, s.normal});
+        resolved.insert(resolved.begin() + static_cast<long>(i), true);
+        continue;  // the same i again: the first half
+      }
+    }
+    ++i;
+  }
+}
+
 // Samples strictly between boundary points a and b.
 FaceCurve sampleCurve(const FaceDomains& domains, const Camera& camera,
-                      const FaceBoundary& boundary, int from, int to, const CurveOptions& options) {
+                      const FaceBoundary& boundary, int from, int to, const CurveOptions& options,
+                      bool alone) {
   FaceCurve curve;
   curve.from = from;
   curve.to = to;
@@ -112,7 +163,6 @@ FaceCurve sampleCurve(const FaceDomains& domains, const Camera& camera,
   double pixels = std::hypot(pa.x - pb.x, pa.y - pb.y);
   int count = std::clamp(static_cast<int>(std::ceil(pixels / options.pixelsPerSample)) - 1, 0,
                          std::max(0, options.curveSamples));
-  if (count == 0) return curve;
   curve.samples.reserve(count);
 
   if (options.mode == CurveMode::PN) {
@@ -141,13 +191,17 @@ FaceCurve sampleCurve(const FaceDomains& domains, const Camera& camera,
   Vec2 along{b.uv.x - a.uv.x, b.uv.y - a.uv.y};
   double span = std::hypot(along.x, along.y);
   Vec2 across = span > 0 ? Vec2{-along.y / span, along.x / span} : Vec2{1, 0};
+  std::vector<bool> resolved;
   for (int i = 1; i <= count; ++i) {
     Vec2 origin = lerp(a.uv, b.uv, static_cast<double>(i) / (count + 1));
     Vec2 uv = origin;
-    if (!solver.solve(origin, across, std::max(0.02 * span, 1e-4), &uv)) ++curve.unresolved;
+    const bool found = solver.solve(origin, across, std::max(0.02 * span, 1e-4), &uv);
+    if (!found) ++curve.unresolved;
     subdiv::LimitSample s = domains.evaluate(boundary.face, uv);
     curve.samples.push_back({uv, s.position, s.normal});
+    resolved.push_back(found);
   }
+  refineSagging(domains, camera, solver, a, b, options, alone, resolved, curve.samples);
   return curve;
 }
 
@@ -211,7 +265,7 @@ std::vector<FaceCurve> faceCurves(const FaceDomains& domains, const Camera& came
   std::vector<FaceCurve> curves;
   for (size_t i = 0; i < x.size(); i += 2) {
     int from = x[(i + offset) % x.size()], to = x[(i + offset + 1) % x.size()];
-    curves.push_back(sampleCurve(domains, camera, boundary, from, to, options));
+    curves.push_back(sampleCurve(domains, camera, boundary, from, to, options, x.size() == 2));
   }
   return curves;
 }

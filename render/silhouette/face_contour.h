@@ -52,6 +52,9 @@ struct CurveOptions {
   CurveMode mode = CurveMode::Exact;
   int curveSamples = 32;  // at most this many samples between two crossings
   double pixelsPerSample = 2.0;
+  // Exact curves: more samples where a chord between two lies farther than this from the
+  // curve in the image (a tight turn), within curveSamples.
+  double maxSagPx = 0.1;
 };
 
 FaceBoundary faceBoundary(const FaceDomains& domains, const ContourSearch& search, int face);

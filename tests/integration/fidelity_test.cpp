@@ -238,6 +238,73 @@ TEST(NGonsAndPoles, EveryMethodIsWithinTargetAroundCapsAndPoles) {
   }
 }
 
+// Tight turns of a contour curve: the table's thin legs and top, seen obliquely. A curve's
+// samples were spaced evenly in (u, v), about one per 2 px of the straight line between its
+// ends, so where the contour turns through a right angle within a few pixels (a leg's rounded
+// end, a slat's end in the held-out fence: 2.16 px) a chord between two samples cut the turn a
+// pixel inside it: 0.99 px here. Samples are now added where a chord sags more than 0.1 px
+// from the curve (0.08 px here).
+TEST(CurveSamples, ATightTurnOfTheContourIsFollowed) {
+  expectOutlineWithin(meshJson(corpusDir() / "table.obj"), R"("method": "silhouette")",
+                      R"({"eye": [1.9163, 0.8782, -0.5094], "target": [0, 0.515, 0],
+                          "up": [0, 1, 0], "projection": "orthographic", "orthoHeight": 2.98714,
+                          "width": 1024, "height": 1024})",
+                      0.5);
+}
+
+// A thin leg: a straight tube of pentagonal section, 0.008 across and 0.45 long, its rings
+// 0.05 apart, closed by a pentagon at each end (the held-out insect's legs). Subdivided, each
+// end tapers to a rounded tip about half a ring spacing past the last ring.
+std::string legWithPentagonCaps() {
+  constexpr int kRings = 10, kSides = 5;
+  std::string obj;
+  for (int i = 0; i < kRings; ++i) {
+    for (int k = 0; k < kSides; ++k) {
+      const double angle = 2 * std::numbers::pi * k / kSides;
+      obj += "v " + std::to_string(0.05 * i) + " " + std::to_string(0.004 * std::cos(angle)) + " " +
+             std::to_string(0.004 * std::sin(angle)) + "\n";
+    }
+  }
+  auto at = [](int ring, int k) { return std::to_string(ring * kSides + k % kSides + 1); };
+  std::string first = "f", last = "f";
+  for (int k = 0; k < kSides; ++k) {
+    for (int i = 0; i + 1 < kRings; ++i) {
+      obj +=
+          "f " + at(i, k) + " " + at(i + 1, k) + " " + at(i + 1, k + 1) + " " + at(i, k + 1) + "\n";
+    }
+    first += " " + at(0, k);
+    last += " " + at(kRings - 1, kSides - k);
+  }
+  obj += first + "\n" + last + "\n";
+  return R"({"format": "obj", "scheme": "catmull-clark", "data": )" + jsonString(obj) + "}";
+}
+
+// A contour curve whose ends lie within 2 px in the image got no sample between them: round a
+// thin leg's tip, the curve on the end cap runs out past the last ring and back, and was drawn
+// as one chord straight across the leg (the held-out insect at 512^2: 3.27 px; here 3.12 px,
+// and over 1 px on 6 of 12 random views). Such a curve is now sampled where its chords sag
+// (CurveSamples.ATightTurnOfTheContourIsFollowed): 0.06 px.
+TEST(CurveSamples, AContourRoundAThinTipIsFollowedPastItsEnds) {
+  expectOutlineWithin(legWithPentagonCaps(),
+                      R"("method": "silhouette", "params": {"presubdivide": 0})",
+                      R"({"eye": [0.464, -1.3189, -0.8635], "target": [0.225, 0, 0],
+                          "up": [0, 1, 0], "fovYDeg": 40, "width": 512, "height": 512})",
+                      1.0);
+}
+
+// Outline edges (a sheet's border, a sharp crease seen front and back) get points along their
+// limit curve, one per 2 px of the edge's length in the image. That length was taken from the
+// chord between the edge's ends, and a short edge can bulge far past it: at the plant's leaf
+// tip a border edge 1.7 px end to end stands 1.4 px off that chord and had no point between
+// its ends (1.20 px). The length is now measured along the curve (0.27 px).
+TEST(CurveSamples, AShortBorderEdgeThatBulgesIsDrawnAlongItsCurve) {
+  expectOutlineWithin(meshJson(corpusDir() / "plant.obj"), R"("method": "silhouette")",
+                      R"({"eye": [0.69753, 3.15166, 2.6347], "target": [0.00383, 0.8198, -0.00763],
+                          "up": [0, 1, 0], "projection": "orthographic", "orthoHeight": 2.362367,
+                          "width": 1024, "height": 1024})",
+                      1.0);
+}
+
 // A gear of 16 teeth as a mesh of over 500 faces has it: two concave 64-gon caps between
 // infinitely sharp rims, not pre-subdivided. The silhouette method triangulated a face without
 // contour curves in its domain, a regular (convex) polygon, so a cap's chords ran from one
