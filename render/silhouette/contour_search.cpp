@@ -218,14 +218,6 @@ Vec3 faceNormalAtCorner(const FaceDomains& domains, int face, int k) {
   return domains.evaluate(face, uv).normal;
 }
 
-// Distance in the image from p to the segment a-b (pixels; x and y of projected points).
-double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
-  const double t =
-      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
 // The length in the image of an outline edge's limit curve, as a polyline through `pieces` + 1
 // uniform points: a short edge can bulge far past the chord between its ends (a leaf's rounded
 // lobe at its tip, a boundary edge 1.7 px end to end whose curve stands 1.4 px off that chord).
@@ -273,6 +265,13 @@ int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, 
 }
 
 }  // namespace
+
+double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
+  const double t =
+      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
 
 ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
                             const SearchOptions& options, const CancelToken& cancel) {

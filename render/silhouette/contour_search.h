@@ -100,4 +100,7 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
 // The point `t` of base edge `edge` in face `face`'s domain (edge must be one of its edges).
 Vec2 edgeUV(const FaceDomains& domains, int face, int edge, double t);
 
+// Distance in the image from p to the segment a-b (pixels; x and y of projected points).
+double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b);
+
 }  // namespace limn::render::silhouette

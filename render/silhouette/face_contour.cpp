@@ -101,14 +101,6 @@ class CrossLineSolver {
   int face_;
 };
 
-// Image distance from p to the segment [a, b].
-double distanceToChordPx(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
-  const double t =
-      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
 // Samples spaced evenly in (u, v) bunch where the curve turns fastest in the image least: at a
 // tip (a slat's rounded end, a leaf's point, a leg's tapering end) two samples a few pixels
 // apart cut the turn with a chord a pixel inside it (the held-out fence's slat end, 2.16 px),
@@ -139,7 +131,7 @@ void refineSagging(const FaceDomains& domains, const Camera& camera, const Cross
                        solver.solve(uv, {-along.y / span, along.x / span}, 0.02 * span, &uv);
     if (split) {
       const subdiv::LimitSample s = domains.evaluate(solver.face(), uv);
-      const double sag = distanceToChordPx(camera.project(s.position), pi, qi);
+      const double sag = distanceToSegmentPx(camera.project(s.position), pi, qi);
       if (sag > options.maxSagPx && (alone || sag < chordPx)) {
         samples.insert(samples.begin() + static_cast<long>(i), {uv, s.position, s.normal});
         resolved.insert(resolved.begin() + static_cast<long>(i), true);
