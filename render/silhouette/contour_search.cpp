@@ -266,13 +266,6 @@ int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, 
 
 }  // namespace
 
-double distanceToSegmentPx(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
-  const double t =
-      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
 ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
                             const SearchOptions& options, const CancelToken& cancel) {
   const subdiv::LimitSurface& surface = domains.surface();

@@ -111,14 +111,6 @@ int loopRate(const FaceDomains& domains, const Camera& camera, int face) {
 constexpr double kBackFacingCos = 1e-3;
 constexpr double kFoldSliverPx = 1.0;
 
-// Distance from p to the segment [a, b], all in the image plane.
-double segmentDistancePx(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  const double t =
-      len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
-}
-
 // Whether a point of polyline `a` lies within kFoldSliverPx of a segment of polyline `b` that
 // does not end at that point (`a` and `b` may be one curve: a hairpin whose legs nearly meet).
 bool curvesCloseInImage(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
@@ -126,7 +118,7 @@ bool curvesCloseInImage(const std::vector<Vec2>& a, const std::vector<Vec2>& b) 
   for (size_t i = 0; i < a.size(); ++i) {
     for (size_t k = 0; k + 1 < b.size(); ++k) {
       if (same && (k + 1 >= i && k <= i)) continue;  // segments through point i
-      if (segmentDistancePx(a[i], b[k], b[k + 1]) < kFoldSliverPx) return true;
+      if (distanceToSegmentPx(a[i], b[k], b[k + 1]) < kFoldSliverPx) return true;
     }
   }
   return false;
@@ -179,7 +171,7 @@ bool withinFoldBand(const Camera& camera, const std::vector<std::vector<Vec2>>& 
     bool near = false;
     for (const std::vector<Vec2>& curve : curves) {
       for (size_t k = 0; k < curve.size() && !near; ++k) {
-        near = segmentDistancePx(p, curve[k], curve[std::min(k + 1, curve.size() - 1)]) <
+        near = distanceToSegmentPx(p, curve[k], curve[std::min(k + 1, curve.size() - 1)]) <
                kFoldSliverPx;
       }
       if (near) break;
@@ -263,10 +255,7 @@ bool segmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
 // that folds over itself in the plane (a face wrapping most of a thin tube) is not clipped there.
 bool concaveInBestPlane(const std::vector<Vec2>& planar) {
   constexpr double kReflexTurn = 1e-3;  // sine of the turn: rounding on straight runs is not one
-  const size_t n = planar.size();
-  double area = 0;
-  for (size_t i = 0; i < n; ++i) area += cross2({0, 0}, planar[i], planar[(i + 1) % n]);
-  if (!(area > 0)) return false;  // no plane (Newell's normal makes the area positive otherwise)
+  const size_t n = planar.size();       // 0 when the boundary has no plane
   bool reflex = false;
   for (size_t i = 0; i < n && !reflex; ++i) {
     const Vec2 &a = planar[(i + n - 1) % n], &b = planar[i], &c = planar[(i + 1) % n];
