@@ -191,14 +191,16 @@ TEST(Lanes, TheWorkerHeavyWorkRunsOnYieldsTheCpuToTheInteractiveOne) {
 }
 
 TEST(Lanes, BackgroundRequestsWaitForTheOthers) {
-  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  // Previews, not tiny renders: two answers written a millisecond apart can be read by the
+  // client in either order, so the one that runs second must finish well after the first.
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1, "heavyRequestMs": 2000})");
   const int port = server.port();
   std::future<Timed> busy = postAsync(port, heavyBody());
   ASSERT_TRUE(waitForMetric(port, "limn_lane_running{lane=\"heavy\"}", 1));
   std::future<Timed> background =
-      postAsync(port, smallBody(), {{"Priority", "u=7"}, {"Authorization", "Bearer b"}});
+      postAsync(port, previewBody(), {{"Priority", "u=7"}, {"Authorization", "Bearer b"}});
   ASSERT_TRUE(waitForMetric(port, "limn_lane_queue_depth{lane=\"batch\"}", 1));
-  std::future<Timed> interactive = postAsync(port, smallBody(), {{"Authorization", "Bearer i"}});
+  std::future<Timed> interactive = postAsync(port, previewBody(), {{"Authorization", "Bearer i"}});
   ASSERT_TRUE(waitForMetric(port, "limn_lane_queue_depth{lane=\"interactive\"}", 1));
   Timed b = background.get(), i = interactive.get();
   EXPECT_EQ(b.response.status, 200);
