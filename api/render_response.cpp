@@ -214,6 +214,7 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
   count("domains", s.tessellation.domains);
   count("transitionEdges", s.tessellation.transitionEdges);
   count("clampedEdges", s.tessellation.clampedEdges);
+  count("crowdedDomains", s.tessellation.crowdedDomains);
   numberField(w, "dicingRate", s.tessellation.dicingRate);
   numberField(w, "tableMs", s.tableMs);
   numberField(w, "tessellateMs", s.tessellateMs);

@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <numbers>
+#include <set>
 #include <string>
 #include <unordered_map>
 
 #include "render/core/error.h"
 #include "render/core/parallel.h"
+#include "render/tessellate/contour_proximity.h"
 
 namespace limn::render::patches {
 
@@ -319,6 +322,7 @@ class Tessellator {
     makeDomains();
     weldCorners();
     findPieces();
+    findCrowdedPieces();
     countSegments();
     if (triangles_ > options_.maxTriangles) throw OverBudget{triangles_};
   }
@@ -503,11 +507,17 @@ class Tessellator {
   int segmentsOf(const PatchDomain& domain, const Piece& piece) {
     const Vec3 a = camera_.project(positions_[piece.from]);
     const Vec3 b = camera_.project(positions_[piece.to]);
-    const Vec3 m =
-        camera_.project(evaluateSample(set_, domain, lerp(piece.a, piece.b, 0.5)).position);
-    double wanted =
-        std::ceil((std::hypot(a.x - m.x, a.y - m.y) + std::hypot(m.x - b.x, m.y - b.y)) /
-                  options_.dicingRate);
+    const bool crowded = crowdedPieces_.count(piece.key()) > 0;
+    const double dicingRate =
+        crowded ? options_.dicingRate / options_.crowdedContourScale : options_.dicingRate;
+    const Vec3 mid = evaluateSample(set_, domain, lerp(piece.a, piece.b, 0.5)).position;
+    const Vec3 m = camera_.project(mid);
+    double pixels = std::hypot(a.x - m.x, a.y - m.y) + std::hypot(m.x - b.x, m.y - b.y);
+    if (crowded) {  // along a contour, as adaptive dices its contour faces
+      pixels = std::max(pixels, tessellate::unforeshortenedPixels(camera_, positions_[piece.from],
+                                                                  mid, positions_[piece.to]));
+    }
+    double wanted = std::ceil(pixels / dicingRate);
     if (camera_.projection() == Projection::Perspective) {
       const bool aBehind = a.z <= camera_.nearPlane(), bBehind = b.z <= camera_.nearPlane();
       if (aBehind && bBehind) wanted = 1;
@@ -542,6 +552,72 @@ class Tessellator {
           if (static_cast<int>(pieces_[p][k].size()) <= options_.maxEdgeFactor) break;
         }
         if (pieces_[p][k].size() > 1) ++stats_.transitionEdges;
+      }
+    }
+  }
+
+  // The pieces of domains whose contour comes close to another part's contour in the image
+  // (tessellate/contour_proximity.h): those are diced crowdedContourScale times finer. A
+  // domain's contour is read from the facing at its corners and side midpoints; domains that
+  // share a vertex, or a patch, are one part.
+  void findCrowdedPieces() {
+    crowdedPieces_.clear();
+    if (options_.crowdedContourScale <= 1) return;
+    std::vector<std::vector<tessellate::ContourPiece>> contour(domains_.size());
+    parallelFor(domains_.size(), 256, [&](size_t begin, size_t end) {
+      std::vector<Vec2> points;
+      std::vector<double> facing;
+      for (size_t p = begin; p < end; ++p) {
+        if (p % kPatchesBetweenChecks == 0) cancel_.check();
+        const PatchDomain& domain = domains_[p];
+        points.clear();
+        facing.clear();
+        bool behind = false;
+        auto add = [&](const Vec3& position, const Vec3& normal) {
+          const Vec3 pixel = camera_.project(position);
+          behind |=
+              camera_.projection() == Projection::Perspective && pixel.z <= camera_.nearPlane();
+          points.push_back({pixel.x, pixel.y});
+          facing.push_back(dot(normal, camera_.viewVector(position)));
+        };
+        for (int k = 0; k < domain.corners(); ++k) {
+          const int id = corners_[p][k];
+          add(positions_[id], normals_[id]);
+          const Sample mid = evaluateSample(
+              set_, domain,
+              lerp(corner(domain, k), corner(domain, (k + 1) % domain.corners()), 0.5));
+          add(mid.position, mid.normal);
+        }
+        if (!behind)
+          tessellate::appendContourPieces(points, facing, static_cast<int>(p), contour[p]);
+      }
+    });
+    std::vector<tessellate::ContourPiece> pieces;
+    for (const auto& c : contour) pieces.insert(pieces.end(), c.begin(), c.end());
+    if (pieces.empty()) return;
+    auto vertices = [&](int p) {
+      std::vector<int> ids;
+      for (int k = 0; k < domains_[p].corners(); ++k) {
+        for (const Piece& piece : pieces_[p][k]) ids.push_back(piece.from);
+      }
+      std::sort(ids.begin(), ids.end());
+      return ids;
+    };
+    auto oneApart = [&](int a, int b) {
+      if (domains_[a].patch == domains_[b].patch) return true;
+      const std::vector<int> va = vertices(a), vb = vertices(b);
+      std::vector<int> shared;
+      std::set_intersection(va.begin(), va.end(), vb.begin(), vb.end(), std::back_inserter(shared));
+      return !shared.empty();
+    };
+    const std::vector<char> crowded = tessellate::ownersNearAnotherContour(
+        pieces, static_cast<int>(domains_.size()), options_.crowdedContourPx, camera_.width(),
+        camera_.height(), oneApart);
+    for (size_t p = 0; p < domains_.size(); ++p) {
+      if (!crowded[p]) continue;
+      ++stats_.crowdedDomains;
+      for (int k = 0; k < domains_[p].corners(); ++k) {
+        for (const Piece& piece : pieces_[p][k]) crowdedPieces_.insert(piece.key());
       }
     }
   }
@@ -671,6 +747,7 @@ class Tessellator {
   std::vector<std::array<int, 4>> corners_;                // welded corner vertices per domain
   std::vector<std::array<std::vector<Piece>, 4>> pieces_;  // per domain and side
   std::map<std::pair<int, int>, int> segments_;            // per piece, by its welded ends
+  std::set<std::pair<int, int>> crowdedPieces_;            // pieces diced finer
   std::map<std::pair<int, int>, std::vector<int>> edgeVertices_;
   size_t triangles_ = 0;
   TessellationStats stats_;

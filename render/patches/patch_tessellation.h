@@ -31,6 +31,10 @@ struct TessellationOptions {
   // Over maxTriangles: true coarsens the dicing rate until the mesh fits (reported in
   // TessellationStats::dicingRate); false throws InputError(LimitExceeded).
   bool fitToBudget = false;
+  // Domains whose contour comes within crowdedContourPx of another part's contour in the image
+  // are diced this many times finer (tessellate/contour_proximity.h); 1 leaves them as they are.
+  double crowdedContourScale = 1;
+  double crowdedContourPx = 1;
 };
 
 struct TessellationStats {
@@ -41,6 +45,7 @@ struct TessellationStats {
   size_t domains = 0;           // the units tessellated: whole patches and parts of split ones
   size_t transitionEdges = 0;   // domain edges split where a finer neighbour meets them
   size_t clampedEdges = 0;      // edge pieces that wanted more than maxEdgeFactor segments
+  size_t crowdedDomains = 0;    // diced finer: their contour runs close to another part's
   double dicingRate = 0;        // the rate used (coarser than asked when fitted to the budget)
 };
 

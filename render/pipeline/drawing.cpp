@@ -20,6 +20,12 @@
 
 namespace limn::render::pipeline {
 
+// How much finer `adaptive` and `patches` dice the faces whose contour runs within a pixel of
+// another part's (tessellate/contour_proximity.h). Measured on the realistic corpus's grazing
+// slits (bench/fidelity_results.md): 1.5 left the humanoid's at 0.78 px, 2 takes every one
+// under 0.25 px.
+constexpr double kCrowdedContourScale = 2;
+
 namespace {
 
 // Normal-map shading: an atlas of the limit normals of `surface`'s faces, sized so the face
@@ -92,6 +98,7 @@ tessellate::TriangleMesh tessellateMethod(const MethodChoice& choice, const JobL
       tessellate::AdaptiveOptions options;
       options.dicingRate = choice.params.dicingRate;
       options.maxTriangles = limits.maxTriangles;
+      options.crowdedContourScale = kCrowdedContourScale;
       tessellate::TriangleMesh mesh =
           tessellate::tessellateAdaptive(surface, camera, options, cancel);
       mesh.closedOutward = closedOutward(surface);  // watertight by construction
@@ -164,6 +171,7 @@ patches::PatchMesh tessellatePatchSet(const patches::PatchSet& set, const Method
   // At 1 px and 1024^2 a coarse Loop mesh would ask for 10M+ triangles (adaptive caps its
   // faces' edges at 128 segments instead): the rate is coarsened to fit, and said.
   options.fitToBudget = true;
+  options.crowdedContourScale = kCrowdedContourScale;
   patches::PatchMesh tessellation =
       dicePatches(set, options, choice.params.tessellator, context, camera, cancel, stats);
   if (tessellation.stats.dicingRate > options.dicingRate) {

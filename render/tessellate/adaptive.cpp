@@ -6,7 +6,9 @@
 // 2. Every edge gets one rate: the largest its faces ask for, a face asking for its edge's
 //    projected length (along the limit curve's corner-midpoint-corner polyline) divided by the
 //    dicing rate, or its unforeshortened length where the face holds a silhouette
-//    (unforeshortenedPixels); callers may raise any edge's count (AdaptiveOptions::minSegments).
+//    (unforeshortenedPixels), and crowdedContourScale times finer where its contour runs
+//    close to another part's (contour_proximity.h); callers may raise any edge's count
+//    (AdaptiveOptions::minSegments).
 // 3. The triangles those rates make are counted (Bfr::Tessellation, nothing evaluated) and
 //    checked against maxTriangles before any memory is spent on them.
 // 4. Faces are tessellated independently (Bfr::Tessellation with those edge rates) and
@@ -22,6 +24,7 @@
 
 #include "render/core/error.h"
 #include "render/core/parallel.h"
+#include "render/tessellate/contour_proximity.h"
 #include "render/tessellate/tessellate.h"
 
 namespace limn::render::tessellate {
@@ -42,18 +45,10 @@ namespace {
 // alone made it 0.03 px at dicingRate 1, for a third more triangles.
 constexpr double kCullMarginCosine = 0.02;
 
-// The length in pixels of the polyline a-m-b as if seen face-on at m's depth. Where a face
-// holds a silhouette (its probes face both ways) its normal lies in the image plane there, so an
-// edge's sag shows at full size however foreshortened the edge itself is (a lathed head's ring
-// edges, seen end-on at its side, project to a fraction of a pixel and bulge by 0.3 px each at
-// 512^2): such edges are diced by this length, as if they faced the eye.
-double unforeshortenedPixels(const Camera& camera, const Vec3& a, const Vec3& m, const Vec3& b) {
-  return (length(m - a) + length(b - m)) * camera.pixelsPerUnit(camera.depthOf(m));
-}
-
 struct FaceProbe {
   bool culled = true;
-  std::vector<double> edgePixels;  // projected length of each edge
+  std::vector<double> edgePixels;     // projected length of each edge
+  std::vector<ContourPiece> contour;  // where the probes change facing, in the image
 };
 
 struct FacePatch {
@@ -73,6 +68,7 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
   rate2.GetBoundaryCoords(uv.data());  // corner 0, mid of edge 0, corner 1, ...
 
   std::vector<Vec3> pixel(2 * n), position(2 * n);
+  std::vector<double> facingOf(2 * n);
   const double margin = 0.05 * std::max(camera.width(), camera.height());
   // Facing the eye or away by the limit normal, which follows the winding.
   bool anyInFront = false, anyTowards = false, anyAway = false;
@@ -84,6 +80,7 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
     subdiv::LimitSample s = surface.evaluate(face, uv[2 * i], uv[2 * i + 1]);
     Vec3 view = camera.viewVector(s.position);
     const double facing = dot(s.normal, view) / std::max(length(view), 1e-300);
+    facingOf[i] = facing;
     if (facing < 1e-3) anyTowards = true;
     if (facing > -1e-3) anyAway = true;
     nearestEdgeOn = std::min(nearestEdgeOn, std::abs(facing));
@@ -117,6 +114,11 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
   // point in, so its hidden side is the one they call "towards".
   const bool allHidden = hiddenSide > 0 ? !anyTowards : hiddenSide < 0 && !anyAway;
   probe.culled = outside || (allHidden && !nearEdgeOn);
+  if (!probe.culled && !partlyBehind && anyTowards && anyAway) {
+    std::vector<Vec2> points(2 * n);
+    for (int i = 0; i < 2 * n; ++i) points[i] = {pixel[i].x, pixel[i].y};
+    appendContourPieces(points, facingOf, face, probe.contour);
+  }
   probe.edgePixels.resize(n);
   for (int k = 0; k < n; ++k) {
     const Vec3& a = pixel[2 * k];
@@ -134,6 +136,31 @@ FaceProbe probeFace(const subdiv::LimitSurface& surface, int face, const Camera&
     }
   }
   return probe;
+}
+
+// Per face: whether its contour comes within a pixel of another part's contour in the image
+// (contour_proximity.h), faces that share a vertex being one part.
+std::vector<char> facesNearAnotherContour(const subdiv::LimitSurface& surface,
+                                          const std::vector<FaceProbe>& probes,
+                                          const Camera& camera, const AdaptiveOptions& options) {
+  const int faceCount = surface.faceCount();
+  if (options.crowdedContourScale <= 1) return std::vector<char>(faceCount, 0);
+  std::vector<ContourPiece> pieces;
+  for (const FaceProbe& probe : probes) {
+    pieces.insert(pieces.end(), probe.contour.begin(), probe.contour.end());
+  }
+  const Far::TopologyLevel& base = surface.baseLevel();
+  auto shareAVertex = [&](int a, int b) {
+    Far::ConstIndexArray va = base.GetFaceVertices(a), vb = base.GetFaceVertices(b);
+    for (int i = 0; i < va.size(); ++i) {
+      for (int j = 0; j < vb.size(); ++j) {
+        if (va[i] == vb[j]) return true;
+      }
+    }
+    return false;
+  };
+  return ownersNearAnotherContour(pieces, faceCount, options.crowdedContourPx, camera.width(),
+                                  camera.height(), shareAVertex);
 }
 
 // Runs fn(face, rates) on all threads for every face with a limit surface, `rates` holding the
@@ -276,14 +303,17 @@ TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camer
   });
 
   // 2. One rate per edge.
+  const std::vector<char> crowded = facesNearAnotherContour(surface, probes, camera, options);
   std::vector<int> edgeRate(base.GetNumEdges(), options.minEdgeRate);
   for (int f = 0; f < faceCount; ++f) {
     if (!surface.hasLimit(f)) continue;
     Far::ConstIndexArray edges = base.GetFaceEdges(f);
+    const double dicingRate =
+        crowded[f] ? options.dicingRate / options.crowdedContourScale : options.dicingRate;
     for (int k = 0; k < edges.size(); ++k) {
       int rate = options.minEdgeRate;
       if (!probes[f].culled) {
-        double segments = std::ceil(probes[f].edgePixels[k] / options.dicingRate);
+        double segments = std::ceil(probes[f].edgePixels[k] / dicingRate);
         rate = static_cast<int>(std::clamp(segments, static_cast<double>(options.minEdgeRate),
                                            static_cast<double>(options.maxEdgeRate)));
       }

@@ -203,6 +203,29 @@ TEST(NarrowSlits, ASlitBetweenTwoArmsIsMeasuredToTheOtherRenderingsSlit) {
       0.5);
 }
 
+// Grazing slits: the humanoid from below, where an arm's outline meets the body's at a few
+// degrees. A surface error delta moves the point where the slit closes by delta / sin(angle):
+// adaptive's and patches' contour 0.03 px off closed it 0.78 px before the reference's. Faces
+// and patch domains whose contour runs within a pixel of another part's, nearly parallel, are
+// now diced twice as fine (tessellate/contour_proximity.h): 0.14 and 0.09 px.
+TEST(GrazingSlits, ASlitBetweenArmAndBodyClosesWhereTheReferencesDoes) {
+  ServerProcess server = ServerProcess::withConfig(R"({"workers": 1})");
+  const std::string body =
+      R"({"mesh": )" + meshJson(corpusDir() / "humanoid.obj") +
+      R"(, "cameras": [{"eye": [-2.3296838, -3.7846540, -3.9348403], "target": [0, 0.419, 0],
+                        "up": [0, 1, 0], "fovYDeg": 47.5794552, "width": 1024, "height": 1024}],
+          "methods": [{"method": "adaptive", "params": {"dicingRate": 1}},
+                      {"method": "patches", "params": {"dicingRate": 1}}]})";
+  HttpResponse r = post(server.port(), "/v1/compare", body);
+  ASSERT_EQ(r.status, 200) << r.body.substr(0, 600);
+  rapidjson::Document doc = parseJson(r.body);
+  ASSERT_EQ(doc["rows"].Size(), 2u);
+  for (const auto& row : doc["rows"].GetArray()) {
+    EXPECT_LE(row["metrics"]["silhouette"]["outlineHausdorffPx"].GetDouble(), 0.3)
+        << row["method"].GetString();
+  }
+}
+
 // N-gon fans next to poles: the fish's decagon caps (Catmull-Clark, a flattened tube) and the
 // flower's valence-12 poles and hexagon cap (Loop), from views that see the caps and poles at
 // the outline. One comparison per view measures every method against one reference.

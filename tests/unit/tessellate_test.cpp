@@ -10,6 +10,7 @@
 
 #include "render/core/error.h"
 #include "render/core/parallel.h"
+#include "render/tessellate/contour_proximity.h"
 #include "tests/unit/test_meshes.h"
 
 namespace limn::render::tessellate {
@@ -345,6 +346,44 @@ TEST(Adaptive, FitToBudgetScalesTheRatesDownInsteadOfRefusing) {
   EXPECT_GT(mesh.triangleCount(), 5000u);
   EXPECT_LT(scaled, 1.0);
   EXPECT_GT(scaled, 0.0);
+}
+
+// Owners 0-3: two nearly parallel pieces half a pixel apart (a grazing slit), a piece crossing
+// the first at a right angle, and a piece far away.
+TEST(ContourProximity, OnlyNearlyParallelPiecesOfDifferentPartsAreNear) {
+  const std::vector<ContourPiece> pieces = {{{10, 10}, {30, 10}, 0},
+                                            {{10, 10.5}, {30, 11.5}, 1},
+                                            {{20, 0}, {20, 20}, 2},
+                                            {{10, 50}, {30, 50}, 3}};
+  auto none = [](int, int) { return false; };
+  EXPECT_EQ(ownersNearAnotherContour(pieces, 4, 1.0, 64, 64, none),
+            (std::vector<char>{1, 1, 0, 0}));
+  // Neighbours' pieces meet where the contour runs from one to the next: not a slit.
+  auto firstTwoAdjacent = [](int a, int b) { return std::min(a, b) == 0 && std::max(a, b) == 1; };
+  EXPECT_EQ(ownersNearAnotherContour(pieces, 4, 1.0, 64, 64, firstTwoAdjacent),
+            (std::vector<char>{0, 0, 0, 0}));
+  // Closer than the distance asked only.
+  EXPECT_EQ(ownersNearAnotherContour(pieces, 4, 0.4, 64, 64, none),
+            (std::vector<char>{0, 0, 0, 0}));
+  // Off the image by more than the distance: not looked at.
+  const std::vector<ContourPiece> outside = {{{-40, 10}, {-20, 10}, 0},
+                                             {{-40, 10.5}, {-20, 10.5}, 1}};
+  EXPECT_EQ(ownersNearAnotherContour(outside, 2, 1.0, 64, 64, none), (std::vector<char>{0, 0}));
+}
+
+TEST(ContourProximity, PiecesJoinWhereTheFacingChangesSign) {
+  // A square of points, facing the eye on its left side and away on its right.
+  const std::vector<Vec2> square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  std::vector<ContourPiece> pieces;
+  appendContourPieces(square, {1, -3, -3, 1}, 7, pieces);
+  ASSERT_EQ(pieces.size(), 1u);
+  EXPECT_EQ(pieces[0].owner, 7);
+  EXPECT_NEAR(pieces[0].a.x, 2.5, 1e-12);  // a quarter of the way from +1 to -3
+  EXPECT_NEAR(pieces[0].b.x, 2.5, 1e-12);
+  EXPECT_NEAR(std::abs(pieces[0].b.y - pieces[0].a.y), 10, 1e-12);
+  pieces.clear();
+  appendContourPieces(square, {1, 1, 1, 1}, 7, pieces);
+  EXPECT_TRUE(pieces.empty());
 }
 
 }  // namespace
