@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <utility>
 
 namespace limn::render::tessellate {
 
@@ -16,7 +18,9 @@ double distanceToSegment(Vec2 p, Vec2 a, Vec2 b) {
   return std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
 }
 
-double cross(Vec2 o, Vec2 a, Vec2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
+double cross(Vec2 o, Vec2 a, Vec2 b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
 
 double distanceBetween(const ContourPiece& p, const ContourPiece& q) {
   const double c1 = cross(p.a, p.b, q.a), c2 = cross(p.a, p.b, q.b);
@@ -36,44 +40,74 @@ bool nearlyParallel(const ContourPiece& p, const ContourPiece& q) {
   return std::abs(px * qy - py * qx) <= kSine * lengths;
 }
 
+// The part of segment a-b inside the box [lo, hi] (Liang-Barsky), or false if none.
+bool clipToBox(Vec2& a, Vec2& b, Vec2 lo, Vec2 hi) {
+  double t0 = 0, t1 = 1;
+  const double d[2] = {b.x - a.x, b.y - a.y}, from[2] = {a.x, a.y};
+  const double low[2] = {lo.x, lo.y}, high[2] = {hi.x, hi.y};
+  for (int axis = 0; axis < 2; ++axis) {
+    if (d[axis] == 0) {
+      if (from[axis] < low[axis] || from[axis] > high[axis]) return false;
+      continue;
+    }
+    double enter = (low[axis] - from[axis]) / d[axis], leave = (high[axis] - from[axis]) / d[axis];
+    if (enter > leave) std::swap(enter, leave);
+    t0 = std::max(t0, enter);
+    t1 = std::min(t1, leave);
+    if (t0 > t1) return false;
+  }
+  const Vec2 start = a;
+  a = {start.x + t0 * d[0], start.y + t0 * d[1]};
+  b = {start.x + t1 * d[0], start.y + t1 * d[1]};
+  return true;
+}
+
 }  // namespace
 
-std::vector<char> ownersNearAnotherContour(const std::vector<ContourPiece>& pieces,
-                                           int ownerCount, double distancePx, int width,
-                                           int height,
+std::vector<char> ownersNearAnotherContour(const std::vector<ContourPiece>& pieces, int ownerCount,
+                                           double distancePx, int width, int height,
                                            const std::function<bool(int, int)>& adjacent) {
   std::vector<char> near(ownerCount, 0);
-  // A grid of cells at least twice the distance, each listing the pieces whose box (grown by
-  // the distance) reaches it; a pair that is close shares a cell.
+  // Each piece (clipped to the image and a margin) lists the grid cells of its points every
+  // half cell. Two pieces within distancePx <= cell / 2 have points within a quarter cell of
+  // their nearest points, so at most a cell apart: in the same or neighbouring cells. Memory
+  // follows the pieces' length, not the image's area.
   const double cell = std::max(4.0, 2 * distancePx);
-  const double margin = distancePx + cell;
-  const int columns = static_cast<int>(std::ceil((width + 2 * margin) / cell));
-  const int rows = static_cast<int>(std::ceil((height + 2 * margin) / cell));
-  std::vector<std::vector<int>> cells(static_cast<size_t>(columns) * rows);
-  auto cellRange = [&](double lo, double hi, int count) {
-    const int first = static_cast<int>(std::floor((lo - distancePx + margin) / cell));
-    const int last = static_cast<int>(std::floor((hi + distancePx + margin) / cell));
-    return std::pair{std::max(first, 0), std::min(last, count - 1)};
-  };
+  const Vec2 lo{-distancePx, -distancePx}, hi{width + distancePx, height + distancePx};
+  const int64_t columns = static_cast<int64_t>(std::ceil((hi.x - lo.x) / cell)) + 1;
+  std::vector<std::pair<int64_t, int>> entries;  // (cell, piece), sorted by cell
   for (size_t i = 0; i < pieces.size(); ++i) {
-    const ContourPiece& p = pieces[i];
-    const auto [x0, x1] = cellRange(std::min(p.a.x, p.b.x), std::max(p.a.x, p.b.x), columns);
-    const auto [y0, y1] = cellRange(std::min(p.a.y, p.b.y), std::max(p.a.y, p.b.y), rows);
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) cells[static_cast<size_t>(y) * columns + x].push_back(i);
+    Vec2 a = pieces[i].a, b = pieces[i].b;
+    if (!clipToBox(a, b, lo, hi)) continue;
+    const int steps = 1 + static_cast<int>(std::hypot(b.x - a.x, b.y - a.y) / (cell / 2));
+    int64_t last = -1;
+    for (int k = 0; k <= steps; ++k) {
+      const double t = static_cast<double>(k) / steps;
+      const int64_t cx = static_cast<int64_t>((a.x + t * (b.x - a.x) - lo.x) / cell);
+      const int64_t cy = static_cast<int64_t>((a.y + t * (b.y - a.y) - lo.y) / cell);
+      const int64_t key = cy * columns + cx;
+      if (key != last) entries.push_back({key, static_cast<int>(i)});
+      last = key;
     }
   }
-  for (const std::vector<int>& list : cells) {
-    for (size_t i = 0; i < list.size(); ++i) {
-      const ContourPiece& p = pieces[list[i]];
-      for (size_t j = i + 1; j < list.size(); ++j) {
-        const ContourPiece& q = pieces[list[j]];
-        if (p.owner == q.owner || (near[p.owner] && near[q.owner])) continue;
-        if (!nearlyParallel(p, q) || distanceBetween(p, q) > distancePx ||
-            adjacent(p.owner, q.owner)) {
-          continue;
-        }
-        near[p.owner] = near[q.owner] = 1;
+  std::sort(entries.begin(), entries.end());
+  entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+  auto compare = [&](int i, int j) {
+    const ContourPiece& p = pieces[i];
+    const ContourPiece& q = pieces[j];
+    if (p.owner == q.owner || (near[p.owner] && near[q.owner])) return;
+    if (!nearlyParallel(p, q) || distanceBetween(p, q) > distancePx || adjacent(p.owner, q.owner)) {
+      return;
+    }
+    near[p.owner] = near[q.owner] = 1;
+  };
+  for (const auto& [key, piece] : entries) {
+    // This cell and the neighbours after it in the sort (the others see this one).
+    for (const int64_t other :
+         {key, key + 1, key + columns - 1, key + columns, key + columns + 1}) {
+      auto it = std::lower_bound(entries.begin(), entries.end(), std::pair<int64_t, int>{other, 0});
+      for (; it != entries.end() && it->first == other; ++it) {
+        if (other != key || it->second > piece) compare(piece, it->second);
       }
     }
   }

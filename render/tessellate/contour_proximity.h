@@ -35,9 +35,8 @@ struct ContourPiece {
 // piece of another owner that `adjacent(i, j)` does not call its neighbour (neighbours' pieces
 // meet where the contour crosses from one to the next). Pieces outside `[0, width] x [0,
 // height]` by more than `distancePx` are left out.
-std::vector<char> ownersNearAnotherContour(const std::vector<ContourPiece>& pieces,
-                                           int ownerCount, double distancePx, int width,
-                                           int height,
+std::vector<char> ownersNearAnotherContour(const std::vector<ContourPiece>& pieces, int ownerCount,
+                                           double distancePx, int width, int height,
                                            const std::function<bool(int, int)>& adjacent);
 
 // The pieces of contour on a closed loop of image points whose `facing` values (view direction

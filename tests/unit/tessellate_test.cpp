@@ -369,6 +369,11 @@ TEST(ContourProximity, OnlyNearlyParallelPiecesOfDifferentPartsAreNear) {
   const std::vector<ContourPiece> outside = {{{-40, 10}, {-20, 10}, 0},
                                              {{-40, 10.5}, {-20, 10.5}, 1}};
   EXPECT_EQ(ownersNearAnotherContour(outside, 2, 1.0, 64, 64, none), (std::vector<char>{0, 0}));
+  // A face near the eye projects to pieces millions of pixels long: only their part in the
+  // image is looked at.
+  const std::vector<ContourPiece> huge = {{{-1e12, 10}, {1e12, 10}, 0},
+                                          {{-1e12, 10.5}, {1e12, 10.5}, 1}};
+  EXPECT_EQ(ownersNearAnotherContour(huge, 2, 1.0, 64, 64, none), (std::vector<char>{1, 1}));
 }
 
 TEST(ContourProximity, PiecesJoinWhereTheFacingChangesSign) {
