@@ -507,17 +507,10 @@ class Tessellator {
   int segmentsOf(const PatchDomain& domain, const Piece& piece) {
     const Vec3 a = camera_.project(positions_[piece.from]);
     const Vec3 b = camera_.project(positions_[piece.to]);
-    const bool crowded = crowdedPieces_.count(piece.key()) > 0;
-    const double dicingRate =
-        crowded ? options_.dicingRate / options_.crowdedContourScale : options_.dicingRate;
     const Vec3 mid = evaluateSample(set_, domain, lerp(piece.a, piece.b, 0.5)).position;
     const Vec3 m = camera_.project(mid);
-    double pixels = std::hypot(a.x - m.x, a.y - m.y) + std::hypot(m.x - b.x, m.y - b.y);
-    if (crowded) {  // along a contour, as adaptive dices its contour faces
-      pixels = std::max(pixels, tessellate::unforeshortenedPixels(camera_, positions_[piece.from],
-                                                                  mid, positions_[piece.to]));
-    }
-    double wanted = std::ceil(pixels / dicingRate);
+    const double projected = std::hypot(a.x - m.x, a.y - m.y) + std::hypot(m.x - b.x, m.y - b.y);
+    double wanted = std::ceil(projected / options_.dicingRate);
     if (camera_.projection() == Projection::Perspective) {
       const bool aBehind = a.z <= camera_.nearPlane(), bBehind = b.z <= camera_.nearPlane();
       if (aBehind && bBehind) wanted = 1;
@@ -526,6 +519,16 @@ class Tessellator {
       }
     }
     if (wanted > options_.maxEdgeFactor) ++stats_.clampedEdges;
+    if (crowdedPieces_.count(piece.key())) {
+      // Finer along a grazing slit, by the length as if it faced the eye (as adaptive dices its
+      // contour faces), up to the cap: that is not the asked rate going unmet.
+      const double pixels =
+          std::max(projected, tessellate::unforeshortenedPixels(camera_, positions_[piece.from],
+                                                                mid, positions_[piece.to]));
+      wanted = std::max(
+          wanted, std::min(std::ceil(pixels * options_.crowdedContourScale / options_.dicingRate),
+                           static_cast<double>(options_.maxEdgeFactor)));
+    }
     return static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options_.maxEdgeFactor)));
   }
 

@@ -42,6 +42,7 @@ bool nearlyParallel(const ContourPiece& p, const ContourPiece& q) {
 
 // The part of segment a-b inside the box [lo, hi] (Liang-Barsky), or false if none.
 bool clipToBox(Vec2& a, Vec2& b, Vec2 lo, Vec2 hi) {
+  if (!std::isfinite(a.x + a.y + b.x + b.y)) return false;  // a degenerate normal's NaN
   double t0 = 0, t1 = 1;
   const double d[2] = {b.x - a.x, b.y - a.y}, from[2] = {a.x, a.y};
   const double low[2] = {lo.x, lo.y}, high[2] = {hi.x, hi.y};

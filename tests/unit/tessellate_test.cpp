@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <tuple>
 
@@ -374,6 +375,10 @@ TEST(ContourProximity, OnlyNearlyParallelPiecesOfDifferentPartsAreNear) {
   const std::vector<ContourPiece> huge = {{{-1e12, 10}, {1e12, 10}, 0},
                                           {{-1e12, 10.5}, {1e12, 10.5}, 1}};
   EXPECT_EQ(ownersNearAnotherContour(huge, 2, 1.0, 64, 64, none), (std::vector<char>{1, 1}));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<ContourPiece> undefined = {{{nan, 10}, {30, 10}, 0},
+                                               {{10, 10.5}, {30, 10.5}, 1}};
+  EXPECT_EQ(ownersNearAnotherContour(undefined, 2, 1.0, 64, 64, none), (std::vector<char>{0, 0}));
 }
 
 TEST(ContourProximity, PiecesJoinWhereTheFacingChangesSign) {
