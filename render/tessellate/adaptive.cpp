@@ -183,13 +183,30 @@ void forEachFaceWithRates(const subdiv::LimitSurface& surface, const std::vector
   });
 }
 
+// Bfr's tessellation of a face with these edge rates. Bfr infers a quad's inner rates as the
+// means of opposite edges' rates, and (in the Bfr Debian ships) a quad one of whose inner rates
+// is 1 while the other is not becomes a fan from its centre: a long thin quad with 1 segment
+// across and 48 along was drawn as 98 chords from its middle, each spanning half the face (on
+// the hat's crown seen from below, such fans stood 1.08 px outside the outline). Such an inner
+// rate is raised to 2, which puts a row of points down the quad's middle.
+Bfr::Tessellation faceTessellation(const Bfr::Parameterization& param, const int* rates) {
+  const int n = param.GetFaceSize();
+  if (n != 4) return Bfr::Tessellation(param, n, rates);
+  int withInner[6] = {
+      rates[0], rates[1], rates[2], rates[3], (rates[0] + rates[2]) / 2, (rates[1] + rates[3]) / 2};
+  for (int k = 0; k < 2; ++k) {
+    if (withInner[4 + k] == 1 && withInner[5 - k] > 1) withInner[4 + k] = 2;
+  }
+  return Bfr::Tessellation(param, 6, withInner);
+}
+
 // Triangles the faces make with these edge rates (Bfr counts them without evaluating).
 size_t countTriangles(const subdiv::LimitSurface& surface, const std::vector<int>& edgeRate,
                       const CancelToken& cancel) {
   std::vector<size_t> perFace(surface.faceCount(), 0);
   forEachFaceWithRates(surface, edgeRate, 256, cancel, [&](int face, const int* rates) {
     Bfr::Parameterization param = surface.parameterization(face);
-    perFace[face] = Bfr::Tessellation(param, param.GetFaceSize(), rates).GetNumFacets();
+    perFace[face] = faceTessellation(param, rates).GetNumFacets();
   });
   size_t total = 0;
   for (size_t n : perFace) total += n;
@@ -228,7 +245,7 @@ void keepToTriangleBudget(const subdiv::LimitSurface& surface, const AdaptiveOpt
 FacePatch tessellateFace(const subdiv::LimitSurface& surface, int face, const int* rates) {
   FacePatch patch;
   Bfr::Parameterization param = surface.parameterization(face);
-  Bfr::Tessellation tess(param, param.GetFaceSize(), rates);
+  Bfr::Tessellation tess = faceTessellation(param, rates);
   patch.boundaryCount = tess.GetNumBoundaryCoords();
   patch.coords.resize(2 * tess.GetNumCoords());
   tess.GetCoords(patch.coords.data());

@@ -203,6 +203,19 @@ TEST(NarrowSlits, ASlitBetweenTwoArmsIsMeasuredToTheOtherRenderingsSlit) {
       0.5);
 }
 
+// Thin quads seen along their length: the hat's crown from below. Its quads near the pole are
+// 1 segment across and up to 48 along; Bfr inferred an inner rate of 1 for them and drew each
+// as a fan from its centre, 98 chords spanning half the face, one of which stood 1.08 px
+// outside the outline. Their inner rate is now at least 2 (docs/engine.md, adaptive): 0.14 px.
+TEST(ThinQuads, AQuadOneSegmentAcrossIsNotDrawnAsAFan) {
+  expectOutlineWithin(meshJson(corpusDir() / "hat.obj"),
+                      R"("method": "adaptive", "params": {"dicingRate": 1})",
+                      R"({"eye": [0.2954715, -0.1417304, -2.6639144], "target": [0, 0.16, 0],
+                          "up": [0, 1, 0], "fovYDeg": 54.0403916, "width": 1024,
+                          "height": 1024})",
+                      0.5);
+}
+
 // Grazing slits: the humanoid from below, where an arm's outline meets the body's at a few
 // degrees. A surface error delta moves the point where the slit closes by delta / sin(angle):
 // adaptive's and patches' contour 0.03 px off closed it 0.78 px before the reference's. Faces
