@@ -2,6 +2,7 @@
 // Header-only; every layer of render/ uses them.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 namespace limn::render {
@@ -54,6 +55,29 @@ inline Vec3 normalize(const Vec3& v) {
 }
 inline bool isFinite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Twice the signed area of the triangle o, a, b: positive when it turns counter-clockwise.
+inline double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+// Whether segments a-b and c-d cross at a point inside both (touching does not count).
+inline bool segmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  const double abc = cross2(a, b, c), abd = cross2(a, b, d);
+  const double cda = cross2(c, d, a), cdb = cross2(c, d, b);
+  return ((abc > 0 && abd < 0) || (abc < 0 && abd > 0)) &&
+         ((cda > 0 && cdb < 0) || (cda < 0 && cdb > 0));
+}
+
+// Distance in the plane from p to the segment a-b, on x and y (Vec2, or Vec3 such as projected
+// image points, whose z is ignored).
+template <typename Point>
+double distanceToSegment2D(const Point& p, const Point& a, const Point& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
+  const double t =
+      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
 }
 
 // Float triple laid out for vertex buffers.

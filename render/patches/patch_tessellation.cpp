@@ -614,7 +614,7 @@ class Tessellator {
       return !shared.empty();
     };
     const std::vector<char> crowded = tessellate::ownersNearAnotherContour(
-        pieces, static_cast<int>(domains_.size()), options_.crowdedContourPx, camera_.width(),
+        pieces, static_cast<int>(domains_.size()), tessellate::kCrowdedContourPx, camera_.width(),
         camera_.height(), oneApart);
     for (size_t p = 0; p < domains_.size(); ++p) {
       if (!crowded[p]) continue;

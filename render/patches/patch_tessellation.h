@@ -31,10 +31,9 @@ struct TessellationOptions {
   // Over maxTriangles: true coarsens the dicing rate until the mesh fits (reported in
   // TessellationStats::dicingRate); false throws InputError(LimitExceeded).
   bool fitToBudget = false;
-  // Domains whose contour comes within crowdedContourPx of another part's contour in the image
+  // Domains whose contour comes within kCrowdedContourPx of another part's contour in the image
   // are diced this many times finer (tessellate/contour_proximity.h); 1 leaves them as they are.
   double crowdedContourScale = 1;
-  double crowdedContourPx = 1;
 };
 
 struct TessellationStats {

@@ -257,7 +257,7 @@ int outlineSegments(const FaceDomains& domains, const Camera& camera, int face, 
     for (int i = 1; i < dense && within; ++i) {
       const double t = static_cast<double>(i) / dense;
       const int j = std::min(n - 1, static_cast<int>(t * n));
-      within = distanceToSegmentPx(samples[i], chords[j], chords[j + 1]) <= tolerancePx;
+      within = distanceToSegment2D(samples[i], chords[j], chords[j + 1]) <= tolerancePx;
     }
     if (within) return n;
   }

@@ -102,14 +102,4 @@ ContourSearch searchContour(const FaceDomains& domains, const Camera& camera,
 // The point `t` of base edge `edge` in face `face`'s domain (edge must be one of its edges).
 Vec2 edgeUV(const FaceDomains& domains, int face, int edge, double t);
 
-// Distance in the image from p to the segment a-b (pixels; x and y of projected points, as
-// Vec3 from Camera::project or Vec2).
-template <typename Point>
-double distanceToSegmentPx(const Point& p, const Point& a, const Point& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
-  const double t =
-      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
-}
-
 }  // namespace limn::render::silhouette

@@ -131,7 +131,7 @@ void refineSagging(const FaceDomains& domains, const Camera& camera, const Cross
                        solver.solve(uv, {-along.y / span, along.x / span}, 0.02 * span, &uv);
     if (split) {
       const subdiv::LimitSample s = domains.evaluate(solver.face(), uv);
-      const double sag = distanceToSegmentPx(camera.project(s.position), pi, qi);
+      const double sag = distanceToSegment2D(camera.project(s.position), pi, qi);
       if (sag > options.maxSagPx && (alone || sag < chordPx)) {
         samples.insert(samples.begin() + static_cast<long>(i), {uv, s.position, s.normal});
         resolved.insert(resolved.begin() + static_cast<long>(i), true);

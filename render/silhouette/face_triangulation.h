@@ -13,11 +13,6 @@
 
 namespace limn::render::silhouette {
 
-// Twice the signed area of the triangle o, a, b: positive when it turns counter-clockwise.
-inline double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
 struct CurvePath {
   int from = -1, to = -1;     // boundary point indices
   std::vector<int> interior;  // point indices of its samples, in order from `from`

@@ -118,7 +118,7 @@ bool curvesCloseInImage(const std::vector<Vec2>& a, const std::vector<Vec2>& b) 
   for (size_t i = 0; i < a.size(); ++i) {
     for (size_t k = 0; k + 1 < b.size(); ++k) {
       if (same && (k + 1 >= i && k <= i)) continue;  // segments through point i
-      if (distanceToSegmentPx(a[i], b[k], b[k + 1]) < kFoldSliverPx) return true;
+      if (distanceToSegment2D(a[i], b[k], b[k + 1]) < kFoldSliverPx) return true;
     }
   }
   return false;
@@ -171,7 +171,7 @@ bool withinFoldBand(const Camera& camera, const std::vector<std::vector<Vec2>>& 
     bool near = false;
     for (const std::vector<Vec2>& curve : curves) {
       for (size_t k = 0; k < curve.size() && !near; ++k) {
-        near = distanceToSegmentPx(p, curve[k], curve[std::min(k + 1, curve.size() - 1)]) <
+        near = distanceToSegment2D(p, curve[k], curve[std::min(k + 1, curve.size() - 1)]) <
                kFoldSliverPx;
       }
       if (near) break;
@@ -237,14 +237,6 @@ std::vector<Vec2> boundaryInBestPlane(const std::vector<FacePoint>& boundary) {
     planar[i] = {dot(boundary[i].position, xAxis), dot(boundary[i].position, yAxis)};
   }
   return planar;
-}
-
-// Whether two segments cross at a point inside both (touching ends do not count).
-bool segmentsCross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
-  const double abc = cross2(a, b, c), abd = cross2(a, b, d);
-  const double cda = cross2(c, d, a), cdb = cross2(c, d, b);
-  return ((abc > 0 && abd < 0) || (abc < 0 && abd > 0)) &&
-         ((cda > 0 && cdb < 0) || (cda < 0 && cdb > 0));
 }
 
 // Whether the boundary, laid in its best plane, is a simple polygon that turns back (a reflex

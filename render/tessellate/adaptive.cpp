@@ -159,7 +159,7 @@ std::vector<char> facesNearAnotherContour(const subdiv::LimitSurface& surface,
     }
     return false;
   };
-  return ownersNearAnotherContour(pieces, faceCount, options.crowdedContourPx, camera.width(),
+  return ownersNearAnotherContour(pieces, faceCount, kCrowdedContourPx, camera.width(),
                                   camera.height(), shareAVertex);
 }
 

@@ -10,24 +10,11 @@ namespace limn::render::tessellate {
 
 namespace {
 
-double distanceToSegment(Vec2 p, Vec2 a, Vec2 b) {
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  const double length2 = dx * dx + dy * dy;
-  const double t =
-      length2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / length2, 0.0, 1.0) : 0.0;
-  return std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
-}
-
-double cross(Vec2 o, Vec2 a, Vec2 b) {
-  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
+// Distance between two pieces: 0 where they cross, else the nearest of their ends to the other.
 double distanceBetween(const ContourPiece& p, const ContourPiece& q) {
-  const double c1 = cross(p.a, p.b, q.a), c2 = cross(p.a, p.b, q.b);
-  const double c3 = cross(q.a, q.b, p.a), c4 = cross(q.a, q.b, p.b);
-  if (((c1 < 0) != (c2 < 0)) && ((c3 < 0) != (c4 < 0))) return 0;  // they cross
-  return std::min({distanceToSegment(p.a, q.a, q.b), distanceToSegment(p.b, q.a, q.b),
-                   distanceToSegment(q.a, p.a, p.b), distanceToSegment(q.b, p.a, p.b)});
+  if (segmentsCross(p.a, p.b, q.a, q.b)) return 0;
+  return std::min({distanceToSegment2D(p.a, q.a, q.b), distanceToSegment2D(p.b, q.a, q.b),
+                   distanceToSegment2D(q.a, p.a, p.b), distanceToSegment2D(q.b, p.a, p.b)});
 }
 
 // Whether the pieces' lines are within kGrazingDegrees of each other (either way along them).

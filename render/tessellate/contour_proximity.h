@@ -25,6 +25,10 @@ inline double unforeshortenedPixels(const Camera& camera, const Vec3& a, const V
   return (length(m - a) + length(b - m)) * camera.pixelsPerUnit(camera.depthOf(m));
 }
 
+// How close two parts' contours must come, in pixels, for their faces to be diced finer: a
+// slit narrower than this is where a contour's error moves the slit's end most.
+constexpr double kCrowdedContourPx = 1;
+
 // A straight piece of a contour in the image (pixels), held by one face or patch.
 struct ContourPiece {
   Vec2 a, b;

@@ -63,10 +63,9 @@ struct AdaptiveOptions {
   // applied whether or not its faces are culled. Projected lengths are foreshortened where the
   // surface turns away at the silhouette; the reference bounds those edges by their 3D length.
   std::function<int(int edge)> minSegments;
-  // Faces whose contour comes within crowdedContourPx of another part's contour in the image
+  // Faces whose contour comes within kCrowdedContourPx of another part's contour in the image
   // are diced this many times finer (contour_proximity.h); 1 leaves them as they are.
   double crowdedContourScale = 1;
-  double crowdedContourPx = 1;
 };
 
 TriangleMesh tessellateAdaptive(const subdiv::LimitSurface& surface, const Camera& camera,
