@@ -57,7 +57,7 @@ void writeRowTimings(Writer& w, const render::pipeline::Timings& t) {
 }
 
 void writeRow(Writer& w, const CompareRow& row, const CompareRequest& request,
-              std::vector<std::string>& warnings) {
+              std::vector<std::string>& warnings, const response::EncodedImages& encoded) {
   const render::pipeline::CompareMethod& method = request.job.methods[row.method];
   w.StartObject();
   w.Key("label");
@@ -84,7 +84,7 @@ void writeRow(Writer& w, const CompareRow& row, const CompareRequest& request,
     if (anyImages(request.job.outputs)) {
       w.Key("images");
       response::writeImages(w, row.images, request.job.outputs, request.encoding, "method",
-                            warnings);
+                            warnings, &encoded);
     }
   }
   w.Key("warnings");
@@ -93,7 +93,7 @@ void writeRow(Writer& w, const CompareRow& row, const CompareRequest& request,
 }
 
 void writeReference(Writer& w, const CompareResult& result, const CompareRequest& request,
-                    std::vector<std::string>& warnings) {
+                    std::vector<std::string>& warnings, const response::EncodedImages& encoded) {
   double referenceMs = 0;
   for (const auto& ref : result.references) referenceMs += ref.referenceMs;
   w.Key("reference");
@@ -125,7 +125,7 @@ void writeReference(Writer& w, const CompareResult& result, const CompareRequest
     if (anyImages(request.job.outputs)) {
       w.Key("images");
       response::writeImages(w, ref.images, request.job.outputs, request.encoding, "reference",
-                            warnings);
+                            warnings, &encoded);
     }
     w.Key("warnings");
     json::writeStrings(w, ref.warnings);
@@ -135,6 +135,18 @@ void writeReference(Writer& w, const CompareResult& result, const CompareRequest
   w.EndObject();
 }
 
+// Every image of the answer, encoded at once (response::EncodedImages).
+response::EncodedImages encodeImages(const CompareResult& result, const CompareRequest& request) {
+  std::vector<response::EncodedImages::Owned> sets;
+  if (anyImages(request.job.outputs)) {
+    for (const CompareRow& row : result.rows) {
+      if (!row.error) sets.push_back({&row.images, "method"});
+    }
+    for (const auto& ref : result.references) sets.push_back({&ref.images, "reference"});
+  }
+  return response::EncodedImages(sets, request.job.outputs, request.encoding);
+}
+
 }  // namespace
 
 std::string writeCompareResponse(const CompareResult& result, const CompareRequest& request,
@@ -142,6 +154,7 @@ std::string writeCompareResponse(const CompareResult& result, const CompareReque
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
   std::vector<std::string> warnings = request.warnings;
+  const response::EncodedImages encoded = encodeImages(result, request);
   rapidjson::StringBuffer buffer;
   Writer w(buffer);
   w.StartObject();
@@ -150,7 +163,7 @@ std::string writeCompareResponse(const CompareResult& result, const CompareReque
   double rowsMs = 0;
   size_t failed = 0;
   for (const CompareRow& row : result.rows) {
-    writeRow(w, row, request, warnings);
+    writeRow(w, row, request, warnings, encoded);
     rowsMs += row.timings.totalMs;
     failed += row.error.has_value();
   }
@@ -159,7 +172,7 @@ std::string writeCompareResponse(const CompareResult& result, const CompareReque
   w.StartArray();
   for (const auto& ref : result.references) response::writeCamera(w, ref.camera);
   w.EndArray();
-  writeReference(w, result, request, warnings);
+  writeReference(w, result, request, warnings, encoded);
 
   w.Key("stats");
   w.StartObject();

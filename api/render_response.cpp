@@ -1,12 +1,15 @@
 // writeRenderResponse: RenderResult -> the 200 answer's JSON, in DESIGN.md's shape. Images are
 // encoded (PNG or EXR) and carried as base64; numbers that are not finite are written as null.
 #include <chrono>
+#include <string_view>
+#include <utility>
 
 #include "api/base64.h"
 #include "api/json_util.h"
 #include "api/render_api.h"
 #include "api/request_parts.h"
 #include "api/response_parts.h"
+#include "render/core/parallel.h"
 
 namespace limn::api {
 
@@ -41,39 +44,50 @@ std::vector<const char*> requestedPasses(const Outputs& outputs) {
   return names;
 }
 
-void writeImages(Writer& w, const render::ImageSet& images, const AnswerShape& shape,
-                 const char* owner, std::vector<std::string>& warnings) {
-  w.StartObject();
-  for (const char* name : requestedPasses(shape.outputs)) {
-    // The contour and cage overlays are drawn over the method's image, the diff compares it
-    // with the reference and the patch image shows its patches; the reference has none.
-    if (std::string_view(owner) == "reference" &&
-        (std::string_view(name) == render::pass::kContours ||
-         std::string_view(name) == render::pass::kCage ||
-         std::string_view(name) == render::pass::kDiff ||
-         std::string_view(name) == render::pass::kPatches)) {
+// The passes of `images` an answer carries for `outputs`, in order, each with its image (null
+// when `owner` did not produce it). The contour and cage overlays are drawn over the method's
+// image, the diff compares it with the reference and the patch image shows its patches; the
+// reference has none.
+std::vector<std::pair<const char*, const render::Image*>> passesToWrite(
+    const render::ImageSet& images, const Outputs& outputs, std::string_view owner) {
+  std::vector<std::pair<const char*, const render::Image*>> passes;
+  for (const char* name : requestedPasses(outputs)) {
+    const std::string_view pass = name;
+    if (owner == "reference" && (pass == render::pass::kContours || pass == render::pass::kCage ||
+                                 pass == render::pass::kDiff || pass == render::pass::kPatches)) {
       continue;
     }
     const render::Image* image = images.find(name);
-    if (!image || image->empty()) {
+    passes.emplace_back(name, image && !image->empty() ? image : nullptr);
+  }
+  return passes;
+}
+
+void writeImages(Writer& w, const render::ImageSet& images, const AnswerShape& shape,
+                 const char* owner, std::vector<std::string>& warnings,
+                 const response::EncodedImages* encodedAhead = nullptr) {
+  w.StartObject();
+  for (const auto& [name, image] : passesToWrite(images, shape.outputs, owner)) {
+    if (!image) {
       warnings.push_back(std::string("output \"") + name + "\" was requested but the " + owner +
                          " did not produce it");
       continue;
     }
-    render::image::EncodedImage encoded =
-        render::image::encode(*image, name, shape.encoding.format, shape.encoding.quality);
+    const response::EncodedPass* ahead = encodedAhead ? encodedAhead->find(image) : nullptr;
+    const response::EncodedPass encoded =
+        ahead ? response::EncodedPass{} : response::encodePass(*image, name, shape.encoding);
+    const response::EncodedPass& pass = ahead ? *ahead : encoded;
     w.Key(name);
     w.StartObject();
     w.Key("mime");
-    json::writeString(w, encoded.mime);
+    json::writeString(w, pass.mime);
     w.Key("width");
-    w.Int(encoded.width);
+    w.Int(pass.width);
     w.Key("height");
-    w.Int(encoded.height);
+    w.Int(pass.height);
     w.Key("data");
-    std::string data = encodeBase64(encoded.bytes);
     // Base64 needs no escaping: skip the writer's per-character scan of a large string.
-    w.RawValue(("\"" + data + "\"").c_str(), data.size() + 2, rapidjson::kStringType);
+    w.RawValue(pass.quotedBase64.c_str(), pass.quotedBase64.size(), rapidjson::kStringType);
     w.EndObject();
   }
   w.EndObject();
@@ -225,13 +239,14 @@ void writePatchStats(Writer& w, const render::pipeline::Stats::Patches& s) {
 }
 
 void writeFrames(Writer& w, const std::vector<render::pipeline::RenderResult::Frame>& frames,
-                 const AnswerShape& shape, std::vector<std::string>& warnings) {
+                 const AnswerShape& shape, std::vector<std::string>& warnings,
+                 const response::EncodedImages* encodedAhead) {
   w.Key("frames");
   w.StartArray();
   for (const auto& frame : frames) {
     w.StartObject();
     w.Key("images");
-    writeImages(w, frame.images, shape, "method", warnings);
+    writeImages(w, frame.images, shape, "method", warnings, encodedAhead);
     w.Key("triangles");
     w.Uint64(frame.triangles);
     numberField(w, "approxMs", frame.approxMs);
@@ -294,6 +309,18 @@ void writeReferenceStages(Writer& w, const render::oracle::ReferenceStats& s, do
   w.EndObject();
 }
 
+// metricsMs split by stage: the silhouette masks, the located outlines, colour/depth/normal, and
+// the distances to the limit surface.
+void writeMetricsStages(Writer& w, const render::metrics::MetricsTimings& s) {
+  w.Key("metricsStages");
+  w.StartObject();
+  numberField(w, "silhouetteMs", s.silhouetteMs);
+  numberField(w, "outlineMs", s.outlineMs);
+  numberField(w, "imageMs", s.imageMs);
+  numberField(w, "geometryMs", s.geometryMs);
+  w.EndObject();
+}
+
 void writeVec3(Writer& w, const render::Vec3& v) {
   w.StartArray();
   writeNumber(w, v.x);
@@ -327,14 +354,46 @@ namespace response {
 
 void writeCamera(Writer& w, const render::Camera& camera) { api::writeCamera(w, camera); }
 
+EncodedPass encodePass(const render::Image& image, const char* passName,
+                       render::image::Encoding encoding) {
+  render::image::EncodedImage encoded =
+      render::image::encode(image, passName, encoding.format, encoding.quality);
+  return {.mime = std::move(encoded.mime),
+          .width = encoded.width,
+          .height = encoded.height,
+          .quotedBase64 = "\"" + encodeBase64(encoded.bytes) + "\""};
+}
+
+EncodedImages::EncodedImages(const std::vector<Owned>& sets, const Outputs& outputs,
+                             render::image::Encoding encoding) {
+  std::vector<std::pair<const char*, const render::Image*>> all;
+  for (const Owned& set : sets) {
+    for (const auto& pass : passesToWrite(*set.images, outputs, set.owner)) {
+      if (pass.second) all.push_back(pass);
+    }
+  }
+  std::vector<EncodedPass> encoded(all.size());
+  render::parallelFor(all.size(), 1, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      encoded[i] = encodePass(*all[i].second, all[i].first, encoding);
+    }
+  });
+  for (size_t i = 0; i < all.size(); ++i) passes_.emplace(all[i].second, std::move(encoded[i]));
+}
+
+const EncodedPass* EncodedImages::find(const render::Image* image) const {
+  auto it = passes_.find(image);
+  return it == passes_.end() ? nullptr : &it->second;
+}
+
 void writeImages(Writer& w, const render::ImageSet& images, const Outputs& outputs,
                  render::image::Encoding encoding, const char* owner,
-                 std::vector<std::string>& warnings) {
+                 std::vector<std::string>& warnings, const EncodedImages* encodedAhead) {
   const std::vector<std::string> none;
   api::writeImages(
       w, images,
       AnswerShape{.outputs = outputs, .reference = false, .encoding = encoding, .warnings = none},
-      owner, warnings);
+      owner, warnings, encodedAhead);
 }
 
 void writeMetrics(Writer& w, const render::metrics::Metrics& metrics) {
@@ -370,23 +429,31 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
   std::vector<std::string> warnings = shape.warnings;
   warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
 
+  std::vector<response::EncodedImages::Owned> sets;
+  if (result.frames.empty()) sets.push_back({&result.images, "method"});
+  for (const auto& frame : result.frames) sets.push_back({&frame.images, "method"});
+  if (shape.reference && result.referenceImages) {
+    sets.push_back({&*result.referenceImages, "reference"});
+  }
+  const response::EncodedImages encoded(sets, shape.outputs, shape.encoding);
+
   rapidjson::StringBuffer buffer;
   Writer w(buffer);
   w.StartObject();
   w.Key("images");
   if (result.frames.empty()) {
-    writeImages(w, result.images, shape, "method", warnings);
+    writeImages(w, result.images, shape, "method", warnings, &encoded);
   } else {  // each frame has its own
     w.StartObject();
     w.EndObject();
-    writeFrames(w, result.frames, shape, warnings);
+    writeFrames(w, result.frames, shape, warnings, &encoded);
   }
   if (shape.reference) {
     w.Key("reference");
     w.StartObject();
     w.Key("images");
     if (result.referenceImages) {
-      writeImages(w, *result.referenceImages, shape, "reference", warnings);
+      writeImages(w, *result.referenceImages, shape, "reference", warnings, &encoded);
     } else {
       w.StartObject();
       w.EndObject();
@@ -416,6 +483,7 @@ std::string writeRenderResponse(const render::pipeline::RenderResult& result,
   numberField(w, "encodeMs", encodeMs);
   numberField(w, "totalMs", t.parseMs + t.totalMs + encodeMs);
   if (t.reference) writeReferenceStages(w, *t.reference, t.crossCheckMs);
+  if (t.metricsStages) writeMetricsStages(w, *t.metricsStages);
   w.EndObject();
 
   w.Key("warnings");

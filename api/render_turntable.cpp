@@ -93,7 +93,7 @@ void writeAnimation(json::Writer& w, const CompareResult& result, const Turntabl
 }
 
 void writeView(json::Writer& w, const RenderRequest& request, const CompareResult& result, size_t k,
-               std::vector<std::string>& warnings) {
+               std::vector<std::string>& warnings, const response::EncodedImages& encoded) {
   const render::pipeline::CompareRow& row = result.rows[k];
   w.StartObject();
   w.Key("azimuthDeg");
@@ -111,7 +111,8 @@ void writeView(json::Writer& w, const RenderRequest& request, const CompareResul
     return;
   }
   w.Key("images");
-  response::writeImages(w, row.images, request.job.outputs, request.encoding, "method", warnings);
+  response::writeImages(w, row.images, request.job.outputs, request.encoding, "method", warnings,
+                        &encoded);
   if (request.job.reference) {
     w.Key("metrics");
     response::writeMetrics(w, row.metrics);
@@ -122,7 +123,7 @@ void writeView(json::Writer& w, const RenderRequest& request, const CompareResul
       response::writeCamera(w, result.references[k].camera);
       w.Key("images");
       response::writeImages(w, result.references[k].images, request.job.outputs, request.encoding,
-                            "reference", warnings);
+                            "reference", warnings, &encoded);
       w.Key("referenceMs");
       w.Double(result.references[k].referenceMs);
       w.EndObject();
@@ -148,6 +149,15 @@ std::string writeTurntable(const RenderRequest& request, const render::pipeline:
       render::pipeline::compare(compareJobOf(request), limits, context, cancel);
   const Turntable& turntable = *request.turntable;
   std::vector<std::string> warnings = request.warnings;
+  std::vector<response::EncodedImages::Owned> sets;
+  for (size_t k = 0; k < result.rows.size(); ++k) {
+    if (result.rows[k].error) continue;
+    sets.push_back({&result.rows[k].images, "method"});
+    if (request.job.reference && k < result.references.size()) {
+      sets.push_back({&result.references[k].images, "reference"});
+    }
+  }
+  const response::EncodedImages encoded(sets, request.job.outputs, request.encoding);
 
   rapidjson::StringBuffer buffer;
   json::Writer w(buffer);
@@ -164,7 +174,9 @@ std::string writeTurntable(const RenderRequest& request, const render::pipeline:
   w.EndObject();
   w.Key("frames");
   w.StartArray();
-  for (size_t k = 0; k < result.rows.size(); ++k) writeView(w, request, result, k, warnings);
+  for (size_t k = 0; k < result.rows.size(); ++k) {
+    writeView(w, request, result, k, warnings, encoded);
+  }
   w.EndArray();
   if (request.job.reference) {
     std::vector<render::metrics::Metrics> measured;

@@ -174,28 +174,29 @@ std::vector<uint32_t> trianglesNearPixels(const tessellate::TriangleMesh& mesh,
 
 }  // namespace
 
-ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
-                                const PassSelection& passes, const CancelToken& cancel,
-                                const ReferenceOptions& options) {
-  ReferenceResult result;
+BegunReference beginReference(const subdiv::LimitSurface& surface, const Camera& camera,
+                              const PassSelection& passes, const CancelToken& cancel,
+                              const ReferenceOptions& options) {
+  BegunReference begun;
+  ReferenceResult& result = begun.result;
   ReferenceStats& stats = result.stats;
 
-  std::shared_ptr<const ReferenceScene> built;
   if (options.cache) {
-    built = options.cache->get(surface, camera, cancel, &stats.sceneCached, options.triangleBudget);
+    begun.scene =
+        options.cache->get(surface, camera, cancel, &stats.sceneCached, options.triangleBudget);
   } else {
-    built = buildReferenceScene(surface, camera, cancel, options.triangleBudget);
+    begun.scene = buildReferenceScene(surface, camera, cancel, options.triangleBudget);
   }
-  const ReferenceTessellation& tessellation = built->tessellation;
+  const ReferenceTessellation& tessellation = begun.scene->tessellation;
   const tessellate::TriangleMesh& mesh = tessellation.mesh;
-  result.coverageMesh = std::shared_ptr<const tessellate::TriangleMesh>(built, &mesh);
-  RTCScene scene = built->scene.get();
+  result.coverageMesh = std::shared_ptr<const tessellate::TriangleMesh>(begun.scene, &mesh);
+  RTCScene scene = begun.scene->scene.get();
   stats.triangles = mesh.triangleCount();
   stats.outlineFaces = tessellation.outlineFaces;
   stats.outlineErrorPx = tessellation.outlineErrorPx;
   if (!stats.sceneCached) {
-    stats.tessellateMs = built->tessellateMs;
-    stats.bvhMs = built->bvhMs;
+    stats.tessellateMs = begun.scene->tessellateMs;
+    stats.bvhMs = begun.scene->bvhMs;
   }
   // Every edge rate scaled by r leaves the chord error 1 / r^2 times larger.
   stats.accuracyPx =
@@ -211,35 +212,49 @@ ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camer
 
   // Primary rays at pixel centres: the passes, and the coverage the supersampled mask starts from.
   auto start = Clock::now();
-  std::vector<PixelHit> hits = castClosestHits(scene, camera, RayPacking::Packet16, cancel);
+  begun.hits = castClosestHits(scene, camera, RayPacking::Packet16, cancel);
   stats.traceMs = msSince(start);
-  stats.raysCast += hits.size();
+  stats.raysCast += begun.hits.size();
 
   start = Clock::now();
-  shadeHits(surface, camera, mesh, hits, passes, cancel, result);
+  shadeHits(surface, camera, mesh, begun.hits, passes, cancel, result);
   if ((passes.color || passes.wireframe) && options.colorSamples.size() > 1) {
     antialiasEdges(
-        scene, camera, hits, options.colorSamples, cancel,
+        scene, camera, begun.hits, options.colorSamples, cancel,
         [&](const PixelRay& ray, const PixelHit& h) { return limitHit(surface, mesh, ray, h); },
         result.images.passes.at(pass::kColor), stats);
   }
   colorAsWireframe(passes, "limit surface", result);
   stats.newtonMs = msSince(start);
+  return begun;
+}
 
+ReferenceResult finishReference(BegunReference begun, const Camera& camera,
+                                const PassSelection& passes, const CancelToken& cancel,
+                                const ReferenceOptions& options) {
+  ReferenceResult& result = begun.result;
   if (passes.supersample > 0) {
-    start = Clock::now();
-    castSupersampledMask(scene, camera, hits, passes.supersample, built->outlineCandidates, options,
-                         cancel, result);
-    stats.maskMs = msSince(start);
+    RTCScene scene = begun.scene->scene.get();
+    auto start = Clock::now();
+    castSupersampledMask(scene, camera, begun.hits, passes.supersample,
+                         begun.scene->outlineCandidates, options, cancel, result);
+    result.stats.maskMs = msSince(start);
     if (options.locateOutline) {
       start = Clock::now();
       result.outline = metrics::locateOutline(result.images.supersampledMask, passes.supersample,
                                               coverageQuery(scene, camera, cancel), cancel,
                                               &result.refinedPixels);
-      stats.outlineMs = msSince(start);
+      result.stats.outlineMs = msSince(start);
     }
   }
-  return result;
+  return std::move(result);
+}
+
+ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
+                                const PassSelection& passes, const CancelToken& cancel,
+                                const ReferenceOptions& options) {
+  return finishReference(beginReference(surface, camera, passes, cancel, options), camera, passes,
+                         cancel, options);
 }
 
 metrics::Outline locateMeshOutline(const tessellate::TriangleMesh& mesh, const Camera& camera,

@@ -23,6 +23,7 @@
 #include "render/core/image.h"
 #include "render/core/passes.h"
 #include "render/metrics/outline.h"
+#include "render/oracle/ray_caster.h"
 #include "render/oracle/reference_scene.h"
 #include "render/subdiv/limit_surface.h"
 
@@ -105,6 +106,23 @@ struct ReferenceOptions {
 // hint says so; elsewhere the pixel's coverage fills its block. A feature thinner than a pixel
 // that falls between pixel centres, and that the hint lacks too, is missed (docs/engine.md).
 ReferenceResult renderReference(const subdiv::LimitSurface& surface, const Camera& camera,
+                                const PassSelection& passes, const CancelToken& cancel,
+                                const ReferenceOptions& options = {});
+
+// renderReference in two halves, so that the first can run while the approximation it will be
+// compared with is drawn: beginReference does all that needs no hint (the scene, cached or
+// built; the primary rays; the shaded passes) and ignores options.maskHint and hintBlocks;
+// finishReference casts the supersampled mask (with the hint) and locates the outline.
+// renderReference(..) is finishReference(beginReference(..), ..) with the same arguments.
+struct BegunReference {
+  ReferenceResult result;
+  std::shared_ptr<const ReferenceScene> scene;
+  std::vector<PixelHit> hits;  // of the primary rays, row-major
+};
+BegunReference beginReference(const subdiv::LimitSurface& surface, const Camera& camera,
+                              const PassSelection& passes, const CancelToken& cancel,
+                              const ReferenceOptions& options = {});
+ReferenceResult finishReference(BegunReference begun, const Camera& camera,
                                 const PassSelection& passes, const CancelToken& cancel,
                                 const ReferenceOptions& options = {});
 

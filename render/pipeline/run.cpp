@@ -1,5 +1,6 @@
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <string>
 
 #include "render/core/error.h"
@@ -14,6 +15,18 @@
 namespace limn::render::pipeline {
 
 namespace {
+
+// Stops work begun beside this thread's (its token cancelled) and waits for it, unless its result
+// was taken: so that nothing it uses is destroyed under it when this thread's work throws.
+struct StopOnUnwind {
+  CancelToken& token;
+  std::future<oracle::BegunReference>& work;
+  ~StopOnUnwind() {
+    if (!work.valid()) return;
+    token.cancel();
+    work.wait();
+  }
+};
 
 void checkJob(const RenderJob& job, const JobLimits& limits) {
   checkMethod({job.mesh, job.method, job.params, job.shading, job.outputs}, limits);
@@ -142,12 +155,42 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
 
   const int S = job.params.metricSupersample;
   const bool measure = job.reference && job.method != Method::Limit;
+  const bool referenced = job.reference || job.method == Method::Limit;
+  const PassSelection referencePassesAsked = referencePasses(measure, S);
+  oracle::ReferenceOptions options{
+      .locateOutline = measure,
+      .cache = context.referenceCache,
+      .triangleBudget = static_cast<double>(limits.maxReferenceTriangles)};
+  options.colorSamples = colorSamples(context, job.outputs);  // asks OpenGL: on this thread
 
-  // The approximation and its raster passes (all of them when metrics need them).
-  std::optional<MethodDrawing> drawing;
+  // The approximation, then its raster passes (all of them when metrics need them).
+  const MethodChoice choice{job.mesh, job.method, job.params, job.shading, job.outputs};
+  std::optional<Approximated> made;
   if (job.method != Method::Limit) {
-    drawing = drawMethod({job.mesh, job.method, job.params, job.shading, job.outputs}, limits,
-                         surface, camera, context, measure, S, cancel);
+    made = approximateMethod(choice, limits, surface, camera, &context, cancel);
+  }
+
+  // The reference's first half needs nothing of the approximation: it runs while the
+  // approximation is drawn, on the core llvmpipe's vertex stage (one thread) leaves idle.
+  CancelToken besideCancel(&cancel);
+  std::future<oracle::BegunReference> begun;
+  double begunMs = 0;
+  if (referenced && made) {
+    begun = std::async(std::launch::async, [&] {
+      Stopwatch own;
+      oracle::BegunReference half =
+          oracle::beginReference(surface, camera, referencePassesAsked, besideCancel, options);
+      begunMs = own.lapMs();
+      return half;
+    });
+  }
+  // When the drawing fails, the reference is stopped and waited for before anything unwinds.
+  const StopOnUnwind stopBeside{besideCancel, begun};
+
+  std::optional<MethodDrawing> drawing;
+  if (made) {
+    drawing = rasterizeApproximation(std::move(*made), choice, surface, camera, context, measure, S,
+                                     cancel);
     const Approximated& approx = drawing->approx;
     result.stats.triangles = approx.stats.triangles;
     result.stats.vertices = approx.stats.vertices;
@@ -163,15 +206,13 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   }
 
   // The exact reference and, for Catmull-Clark, its independent cross-check.
-  if (job.reference || job.method == Method::Limit) {
-    oracle::ReferenceOptions options{
-        .maskHint = drawing ? &drawing->images.supersampledMask : nullptr,
-        .locateOutline = measure,
-        .cache = context.referenceCache,
-        .triangleBudget = static_cast<double>(limits.maxReferenceTriangles)};
-    options.colorSamples = colorSamples(context, job.outputs);
+  if (referenced) {
+    options.maskHint = drawing ? &drawing->images.supersampledMask : nullptr;
+    Stopwatch own;
     oracle::ReferenceResult reference =
-        oracle::renderReference(surface, camera, referencePasses(measure, S), cancel, options);
+        begun.valid()
+            ? oracle::finishReference(begun.get(), camera, referencePassesAsked, cancel, options)
+            : oracle::renderReference(surface, camera, referencePassesAsked, cancel, options);
     result.stats.referenceTriangles = reference.stats.triangles;
     result.warnings.insert(result.warnings.end(), reference.warnings.begin(),
                            reference.warnings.end());
@@ -181,7 +222,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       crossCheckReference(surface, camera, S, reference, cancel, result);
       result.timings.crossCheckMs = crossCheck.lapMs();
     }
-    result.timings.referenceMs = clock.lapMs();
+    clock.lapMs();
+    result.timings.referenceMs = begunMs + own.lapMs();
     cancel.check();
 
     if (measure) {

@@ -888,7 +888,9 @@ render::pipeline::RenderResult handMadeResult() {
   stats.vertices = 24002;
   stats.referenceTriangles = 1u << 20;
   stats.referenceCrossCheckPx = 0.125;
-  render::pipeline::Timings timings{0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 20.0, std::nullopt, 0.0};
+  render::pipeline::Timings timings{
+      0.5, 1.0,  2.0,          3.0, 4.0,
+      5.0, 20.0, std::nullopt, 0.0, render::metrics::MetricsTimings{0.25, 0.5, 0.75, 1.25}};
   timings.reference = render::oracle::ReferenceStats{};
   timings.reference->sceneCached = true;
   timings.reference->newtonMs = 1.5;
@@ -965,6 +967,9 @@ TEST(RenderResponse, HasTheDesignShape) {
   ASSERT_TRUE(t.HasMember("referenceStages"));
   EXPECT_TRUE(t["referenceStages"]["sceneCached"].GetBool());
   EXPECT_DOUBLE_EQ(t["referenceStages"]["newtonMs"].GetDouble(), 1.5);
+  ASSERT_TRUE(t.HasMember("metricsStages"));
+  EXPECT_DOUBLE_EQ(t["metricsStages"]["silhouetteMs"].GetDouble(), 0.25);
+  EXPECT_DOUBLE_EQ(t["metricsStages"]["geometryMs"].GetDouble(), 1.25);
 
   const rapidjson::Value& w = doc["warnings"];
   ASSERT_EQ(w.Size(), 2u);
@@ -1046,13 +1051,20 @@ TEST(HandleRender, TurnsEveryFailureIntoAJsonError) {
   EXPECT_TRUE(contains(doc["error"]["message"].GetString(), "rasterizer"));
 }
 
-TEST(HandleRender, RendersTheCubeEndToEnd) {
-  std::unique_ptr<render::raster::Rasterizer> rasterizer;
+// A rasteriser, or null with the reason in `why` where this machine has no EGL/OpenGL context.
+std::unique_ptr<render::raster::Rasterizer> tryRasterizer(std::string& why) {
   try {
-    rasterizer = std::make_unique<render::raster::Rasterizer>();
+    return std::make_unique<render::raster::Rasterizer>();
   } catch (const std::exception& e) {
-    GTEST_SKIP() << "no EGL/OpenGL context: " << e.what();
+    why = e.what();
+    return nullptr;
   }
+}
+
+TEST(HandleRender, RendersTheCubeEndToEnd) {
+  std::string noContext;
+  std::unique_ptr<render::raster::Rasterizer> rasterizer = tryRasterizer(noContext);
+  if (!rasterizer) GTEST_SKIP() << "no EGL/OpenGL context: " << noContext;
   render::pipeline::RenderContext context{.rasterizer = rasterizer.get()};
   render::CancelToken cancel;
   api::Answer answer =
@@ -1071,6 +1083,33 @@ TEST(HandleRender, RendersTheCubeEndToEnd) {
       render::image::decode(*api::decodeBase64(doc["images"]["mask"]["data"].GetString()));
   EXPECT_GT(mask.at(32, 24), 0.5f);  // the cube covers the centre
   EXPECT_LT(mask.at(0, 0), 0.5f);    // and not the corner
+}
+
+// A compared render begins its reference beside the drawing (pipeline/run.cpp): a deadline that
+// passes anywhere, in the drawing or in the reference, ends the request with the timeout answer
+// (both halves stopped, nothing left running on the context), and the next request on the same
+// context is answered in full. The deadlines are spread over a render of ~100 ms and more.
+TEST(HandleRender, ADeadlineAnywhereInACompareEndsItCleanly) {
+  std::string noContext;
+  std::unique_ptr<render::raster::Rasterizer> rasterizer = tryRasterizer(noContext);
+  if (!rasterizer) GTEST_SKIP() << "no EGL/OpenGL context: " << noContext;
+  render::pipeline::RenderContext context{.rasterizer = rasterizer.get()};
+  const std::string compared = cubeRequest(R"(, "method": "uniform", "params": {"level": 5},
+      "reference": true, "camera": {"width": 512, "height": 512}, "outputs": ["color"])");
+  int timedOut = 0;
+  for (int ms : {1, 5, 10, 20, 40, 80, 160, 320, 640}) {
+    render::CancelToken cancel(std::chrono::steady_clock::now() + std::chrono::milliseconds(ms));
+    api::Answer answer = api::handleRender(compared, {}, context, cancel);
+    ASSERT_TRUE(answer.status == 200 || answer.status == 504) << ms << " ms: " << answer.body;
+    timedOut += answer.status == 504;
+  }
+  EXPECT_GT(timedOut, 0);  // 1 ms cannot hold a 512^2 comparison
+  render::CancelToken none;
+  api::Answer full = api::handleRender(compared, {}, context, none);
+  ASSERT_EQ(full.status, 200) << full.body;
+  rapidjson::Document doc = parseBody(full);
+  EXPECT_LT(doc["metrics"]["silhouette"]["hausdorffPx"].GetDouble(), 1.0);
+  EXPECT_TRUE(doc["reference"]["images"].HasMember("color"));
 }
 
 // ---------------------------------------------------------------------------------------------

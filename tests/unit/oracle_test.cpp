@@ -681,6 +681,50 @@ TEST(Reference, CancelledTokenStopsTheJob) {
   EXPECT_THROW(embreeSubdivisionMask(surface, camera, cancel, nullptr), Cancelled);
 }
 
+// A token made with a parent expires with it; cancelling the child leaves the parent running.
+TEST(Reference, ATokenExpiresWithItsParent) {
+  CancelToken parent;
+  CancelToken child(&parent);
+  EXPECT_FALSE(child.expired());
+  child.cancel();
+  EXPECT_TRUE(child.expired());
+  EXPECT_FALSE(parent.expired());
+  CancelToken second(&parent);
+  parent.cancel();
+  EXPECT_TRUE(second.expired());
+  EXPECT_THROW(second.check(), Cancelled);
+}
+
+// The two halves a compared render runs apart (the first beside the drawing) give what the
+// whole reference gives, bit for bit: the passes, the hinted mask and the outline.
+TEST(Reference, BegunAndFinishedIsTheWholeReference) {
+  subdiv::LimitSurface surface(testing::cube());
+  const Camera camera = viewOf(surface, 96);
+  const int S = 4;
+  Mask hint(camera.width() * S, camera.height() * S);
+  for (int y = 100; y < 140; ++y) {
+    for (int x = 150; x < 170; ++x) hint.at(x, y) = 1;  // a sliver the reference lacks
+  }
+  const ReferenceOptions options{.maskHint = &hint, .locateOutline = true};
+  ReferenceResult whole = renderReference(surface, camera, allPasses(S), CancelToken(), options);
+  ReferenceResult halves =
+      finishReference(beginReference(surface, camera, allPasses(S), CancelToken(), options), camera,
+                      allPasses(S), CancelToken(), options);
+  for (const char* name : {pass::kColor, pass::kMask, pass::kDepth, pass::kNormal}) {
+    ASSERT_TRUE(whole.images.find(name) && halves.images.find(name)) << name;
+    EXPECT_EQ(whole.images.find(name)->pixels, halves.images.find(name)->pixels) << name;
+  }
+  EXPECT_EQ(whole.images.supersampledMask.covered, halves.images.supersampledMask.covered);
+  EXPECT_EQ(whole.refinedPixels, halves.refinedPixels);
+  ASSERT_EQ(whole.outline.points.size(), halves.outline.points.size());
+  EXPECT_GT(whole.outline.points.size(), 0u);
+  for (size_t i = 0; i < whole.outline.points.size(); ++i) {
+    EXPECT_EQ(whole.outline.points[i].x, halves.outline.points[i].x);
+    EXPECT_EQ(whole.outline.points[i].y, halves.outline.points[i].y);
+  }
+  EXPECT_EQ(whole.stats.raysCast, halves.stats.raysCast);
+}
+
 // ---- The corpus, where present ----
 
 TEST(Corpus, PathsAgreeOnCatmullClarkShapes) {
