@@ -6,6 +6,7 @@
 #include "render/pipeline/drawing.h"
 #include "render/pipeline/job_checks.h"
 #include "render/pipeline/measure.h"
+#include "render/pipeline/reference_beside.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::pipeline {
@@ -90,6 +91,14 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
   std::vector<CompareRow> rows(job.methods.size());
   std::vector<std::optional<MethodDrawing>> drawings(job.methods.size());
   std::vector<uint8_t> hint;
+  // The reference's first half runs while the methods are drawn (reference_beside.h).
+  oracle::ReferenceOptions options{
+      .locateOutline = true,
+      .cache = context.referenceCache,
+      .triangleBudget = static_cast<double>(limits.maxReferenceTriangles),
+      .colorSamples = colorSamples(context, job.outputs)};
+  std::optional<ReferenceBeside> beside;
+  if (job.reference) beside.emplace(surface, camera, referencePasses(true, S), cancel, options);
   for (size_t m = 0; m < job.methods.size(); ++m) {
     rows[m].method = m;
     rows[m].camera = c;
@@ -114,16 +123,9 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
   CompareReference ref{
       .camera = camera, .stats = {}, .referenceMs = 0, .images = {}, .warnings = {}};
   if (!hint.empty()) {  // else every method failed: nothing to measure
-    Stopwatch clock;
-    oracle::ReferenceResult reference = oracle::renderReference(
-        surface, camera, referencePasses(true, S), cancel,
-        {.maskHint = nullptr,
-         .hintBlocks = &hint,
-         .locateOutline = true,
-         .cache = context.referenceCache,
-         .triangleBudget = static_cast<double>(limits.maxReferenceTriangles),
-         .colorSamples = colorSamples(context, job.outputs)});
-    ref.referenceMs = clock.lapMs();
+    options.hintBlocks = &hint;
+    oracle::ReferenceResult reference = beside->finish(options);
+    ref.referenceMs = beside->ownMs();
     ref.stats = reference.stats;
     ref.warnings = reference.warnings;
     if (auto fewer = antialiasWarning(context, job.outputs)) ref.warnings.push_back(*fewer);

@@ -1,6 +1,5 @@
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <string>
 
 #include "render/core/error.h"
@@ -9,24 +8,13 @@
 #include "render/pipeline/drawing.h"
 #include "render/pipeline/job_checks.h"
 #include "render/pipeline/measure.h"
+#include "render/pipeline/reference_beside.h"
 #include "render/pipeline/render_job.h"
 #include "render/subdiv/limit_surface.h"
 
 namespace limn::render::pipeline {
 
 namespace {
-
-// Stops work begun beside this thread's (its token cancelled) and waits for it, unless its result
-// was taken: so that nothing it uses is destroyed under it when this thread's work throws.
-struct StopOnUnwind {
-  CancelToken& token;
-  std::future<oracle::BegunReference>& work;
-  ~StopOnUnwind() {
-    if (!work.valid()) return;
-    token.cancel();
-    work.wait();
-  }
-};
 
 void checkJob(const RenderJob& job, const JobLimits& limits) {
   checkMethod({job.mesh, job.method, job.params, job.shading, job.outputs}, limits);
@@ -171,21 +159,9 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
   }
 
   // The reference's first half needs nothing of the approximation: it runs while the
-  // approximation is drawn, on the core llvmpipe's vertex stage (one thread) leaves idle.
-  CancelToken besideCancel(&cancel);
-  std::future<oracle::BegunReference> begun;
-  double begunMs = 0;
-  if (referenced && made) {
-    begun = std::async(std::launch::async, [&] {
-      Stopwatch own;
-      oracle::BegunReference half =
-          oracle::beginReference(surface, camera, referencePassesAsked, besideCancel, options);
-      begunMs = own.lapMs();
-      return half;
-    });
-  }
-  // When the drawing fails, the reference is stopped and waited for before anything unwinds.
-  const StopOnUnwind stopBeside{besideCancel, begun};
+  // approximation is rasterised (reference_beside.h).
+  std::optional<ReferenceBeside> beside;
+  if (referenced && made) beside.emplace(surface, camera, referencePassesAsked, cancel, options);
 
   std::optional<MethodDrawing> drawing;
   if (made) {
@@ -210,9 +186,9 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
     options.maskHint = drawing ? &drawing->images.supersampledMask : nullptr;
     Stopwatch own;
     oracle::ReferenceResult reference =
-        begun.valid()
-            ? oracle::finishReference(begun.get(), camera, referencePassesAsked, cancel, options)
-            : oracle::renderReference(surface, camera, referencePassesAsked, cancel, options);
+        beside ? beside->finish(options)
+               : oracle::renderReference(surface, camera, referencePassesAsked, cancel, options);
+    const double referenceMs = beside ? beside->ownMs() : own.lapMs();
     result.stats.referenceTriangles = reference.stats.triangles;
     result.warnings.insert(result.warnings.end(), reference.warnings.begin(),
                            reference.warnings.end());
@@ -223,7 +199,7 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       result.timings.crossCheckMs = crossCheck.lapMs();
     }
     clock.lapMs();
-    result.timings.referenceMs = begunMs + own.lapMs();
+    result.timings.referenceMs = referenceMs + result.timings.crossCheckMs;
     cancel.check();
 
     if (measure) {
