@@ -121,7 +121,10 @@ class FlagCounts {
 };
 
 // The triangles whose screen bounding box comes within `marginPx` of a flagged output pixel,
-// and every triangle reaching behind the near plane (its projection is no triangle).
+// and every triangle reaching behind the near plane (its projection is no triangle). Of a mesh
+// closed and wound outward that is wholly in front of the near plane, only the front faces:
+// each back face lies behind a front face, so it covers nothing more (the rasteriser draws the
+// same mesh's coverage without them), and near an outline they are half the triangles.
 std::vector<uint32_t> trianglesNearPixels(const tessellate::TriangleMesh& mesh,
                                           const Camera& camera, const std::vector<char>& flags,
                                           int marginPx) {
@@ -137,6 +140,9 @@ std::vector<uint32_t> trianglesNearPixels(const tessellate::TriangleMesh& mesh,
                         projected[v] = camera.project(mesh.positions[v].toDouble());
                       }
                     });
+  const bool frontFacesOnly =
+      mesh.closedOutward && std::all_of(projected.begin(), projected.end(),
+                                        [&](const Vec3& p) { return p.z > camera.nearPlane(); });
   const size_t triangles = mesh.triangleCount();
   std::vector<char> keep(triangles, 0);
   tbb::parallel_for(
@@ -148,6 +154,10 @@ std::vector<uint32_t> trianglesNearPixels(const tessellate::TriangleMesh& mesh,
           const double near = camera.nearPlane();
           if (!(a.z > near && b.z > near && c.z > near)) {
             keep[t] = 1;
+            continue;
+          }
+          // Image y runs down: a face wound counter-clockwise towards the eye turns clockwise.
+          if (frontFacesOnly && !(cross2(Vec2(a.x, a.y), Vec2(b.x, b.y), Vec2(c.x, c.y)) < 0)) {
             continue;
           }
           // Boxes far outside the image clamp to nothing; NaNs are kept.

@@ -450,15 +450,23 @@ TEST(Reference, RefinedPixelsHoldTheHintedApproximationsWholeOutline) {
 // found with the small scene and the whole one are within kOutlineTolerancePx of each other.
 // (At 1024^2 on the bench's models this moved outlineMeanPx by at most 4.5e-7 px and left
 // outlineHausdorffPx unchanged.) A dense adaptive tessellation, as the pipeline draws.
+// The nearby scene of a closed mesh also leaves its back faces out (trianglesNearPixels).
 TEST(Reference, ApproximationOutlineFromTheNearbyTrianglesAgreesWithTheWholeMesh) {
+  int closed = 0;
   for (const View& v : ownViews()) {
     subdiv::LimitSurface surface(v.mesh);
     const Camera camera = cameraOf(surface, v, 256);
     const int S = 4;
     tessellate::AdaptiveOptions options;
     options.dicingRate = 1.0;
-    const tessellate::TriangleMesh approx =
-        tessellate::tessellateAdaptive(surface, camera, options, {});
+    tessellate::TriangleMesh approx = tessellate::tessellateAdaptive(surface, camera, options, {});
+    // As the pipeline marks an adaptive mesh (drawing.cpp): every face on a closed piece wound
+    // outward.
+    approx.closedOutward = true;
+    for (int f = 0; f < surface.faceCount(); ++f) {
+      approx.closedOutward &= surface.hasLimit(f) && surface.hiddenSide(f) > 0;
+    }
+    closed += approx.closedOutward;
     EmbreeScene whole = buildTriangleScene(approx, RTC_BUILD_QUALITY_LOW);
     const Mask mask = castCoverage(whole.get(), camera.scaled(S), RayPacking::Packet16, {});
     const ReferenceResult r =
@@ -473,6 +481,7 @@ TEST(Reference, ApproximationOutlineFromTheNearbyTrianglesAgreesWithTheWholeMesh
     EXPECT_LE(d.hausdorffPx, metrics::kOutlineTolerancePx) << v.name;
     EXPECT_LE(d.meanPx, 1e-6) << v.name;
   }
+  EXPECT_GT(closed, 0);
 }
 
 TEST(ReferenceCache, SecondRequestForTheSameViewReusesTheScene) {
