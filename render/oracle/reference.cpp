@@ -157,7 +157,7 @@ std::vector<uint32_t> trianglesNearPixels(const tessellate::TriangleMesh& mesh,
             continue;
           }
           // Image y runs down: a face wound counter-clockwise towards the eye turns clockwise.
-          if (frontFacesOnly && !(cross2(Vec2(a.x, a.y), Vec2(b.x, b.y), Vec2(c.x, c.y)) < 0)) {
+          if (frontFacesOnly && !(cross2(Vec2{a.x, a.y}, Vec2{b.x, b.y}, Vec2{c.x, c.y}) < 0)) {
             continue;
           }
           // Boxes far outside the image clamp to nothing; NaNs are kept.
