@@ -92,13 +92,15 @@ void compareCamera(const CompareJob& job, size_t c, const JobLimits& limits,
   std::vector<std::optional<MethodDrawing>> drawings(job.methods.size());
   std::vector<uint8_t> hint;
   // The reference's first half runs while the methods are drawn (reference_beside.h).
-  oracle::ReferenceOptions options{
-      .locateOutline = true,
-      .cache = context.referenceCache,
-      .triangleBudget = static_cast<double>(limits.maxReferenceTriangles),
-      .colorSamples = colorSamples(context, job.outputs)};
+  oracle::ReferenceOptions options;
   std::optional<ReferenceBeside> beside;
-  if (job.reference) beside.emplace(surface, camera, referencePasses(true, S), cancel, options);
+  if (job.reference) {
+    options = {.locateOutline = true,
+               .cache = context.referenceCache,
+               .triangleBudget = static_cast<double>(limits.maxReferenceTriangles),
+               .colorSamples = colorSamples(context, job.outputs)};
+    beside.emplace(surface, camera, referencePasses(true, S), cancel, options);
+  }
   for (size_t m = 0; m < job.methods.size(); ++m) {
     rows[m].method = m;
     rows[m].camera = c;

@@ -149,7 +149,8 @@ RenderResult run(const RenderJob& job, const JobLimits& limits, RenderContext& c
       .locateOutline = measure,
       .cache = context.referenceCache,
       .triangleBudget = static_cast<double>(limits.maxReferenceTriangles)};
-  options.colorSamples = colorSamples(context, job.outputs);  // asks OpenGL: on this thread
+  // Asks OpenGL (so on this thread), and only when a reference is made: a plain render's time.
+  if (referenced) options.colorSamples = colorSamples(context, job.outputs);
 
   // The approximation, then its raster passes (all of them when metrics need them).
   const MethodChoice choice{job.mesh, job.method, job.params, job.shading, job.outputs};
