@@ -929,6 +929,11 @@ TEST(RenderResponse, HasTheDesignShape) {
   const rapidjson::Value& ref = doc["reference"]["images"];
   EXPECT_TRUE(ref.HasMember("color"));
   EXPECT_TRUE(ref.HasMember("mask"));
+  // The reference's own picture (linear 0.25), not the method's: the answer's images are
+  // encoded together before they are written, each found again by its image.
+  render::Image refColor =
+      render::image::decode(*api::decodeBase64(ref["color"]["data"].GetString()));
+  EXPECT_NEAR(refColor.at(1, 2, 0), render::shading::linearToSrgb(0.25f), 1.0f / 255);
 
   const rapidjson::Value& m = doc["metrics"];
   EXPECT_DOUBLE_EQ(m["silhouette"]["hausdorffPx"].GetDouble(), 0.31);
